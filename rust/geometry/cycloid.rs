@@ -1,0 +1,427 @@
+//! The exact cycloid disc: pin-centre curve, actual profile, normals, curvature, validity rules.
+//!
+//! Disc frame, origin at the disc centre, parameter `phi` (rad). With the generating radius
+//! `R = rp + d_rp`, generating pin radius `r = rrp + d_rrp` and curtate ratio `K1 = e zp / R`:
+//!
+//! - pin-centre curve `C(phi) = R (cos phi, sin phi) - e (cos zp phi, sin zp phi)`;
+//! - outward unit normal `n = (cos phi - K1 cos zp phi, sin phi - K1 sin zp phi) / S`,
+//!   `S = sqrt(1 + K1^2 - 2 K1 cos(zc phi))`;
+//! - actual profile `P = C - r n`, turned by the rotation modification `d_delta`.
+//!
+//! `phi = 0` is a tooth root (valley), `zc phi = pi` a lobe tip. The pins stay on the circle
+//! `rp` with radius `rrp`; the modifications only change the ground profile.
+
+use crate::error::{Result, RvdynError, require_finite, require_non_negative, require_positive};
+use crate::geometry::profile_seed::ProfileSeed;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// The parameters that define a cycloid disc and its pin ring (SI units).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CycloidParams {
+    /// Number of pins `zp` (the disc has `zp - 1` lobes).
+    pub pins: u32,
+    /// Eccentricity `e` [m].
+    pub eccentricity: f64,
+    /// Pin circle radius `rp` [m].
+    pub pin_circle_radius: f64,
+    /// Pin radius `rrp` [m].
+    pub pin_radius: f64,
+    /// Disc face width [m].
+    pub face_width: f64,
+    /// Shift modification `d_rp` [m] (grinding convention: `rp -> rp + d_rp`).
+    #[serde(default)]
+    pub d_rp: f64,
+    /// Equidistant modification `d_rrp` [m] (`rrp -> rrp + d_rrp`; positive removes material).
+    #[serde(default)]
+    pub d_rrp: f64,
+    /// Rotation modification `d_delta` [rad] (the profile turned by this angle).
+    #[serde(default)]
+    pub d_delta: f64,
+}
+
+/// A validated cycloid disc with its exact profile and the polyline used to seed gap queries.
+#[derive(Clone)]
+pub struct CycloidGeometry {
+    params: CycloidParams,
+    zp: f64,
+    zc: f64,
+    /// Generating radius `rp + d_rp` [m].
+    gen_radius: f64,
+    /// Generating pin radius `rrp + d_rrp` [m].
+    gen_pin_radius: f64,
+    k1: f64,
+    min_convex_radius: f64,
+    pub(crate) seed: ProfileSeed,
+}
+
+impl std::fmt::Debug for CycloidGeometry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CycloidGeometry")
+            .field("params", &self.params)
+            .field("k1", &self.k1)
+            .field("min_convex_radius", &self.min_convex_radius)
+            .finish()
+    }
+}
+
+/// Points, first and second derivatives of the pin-centre curve at one parameter.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CurveJet {
+    pub c: [f64; 2],
+    pub d1: [f64; 2],
+    pub d2: [f64; 2],
+}
+
+impl CycloidGeometry {
+    /// Build and validate a disc.
+    ///
+    /// Errors (`RvdynError::Geometry`) name the rule broken and its limit: fewer than 3 pins,
+    /// curtate ratio `K1 = e zp / (rp + d_rp) >= 1`, overlapping pins (`rp sin(pi/zp) <= rrp`),
+    /// undercut (`rrp + d_rrp >=` the minimum convex radius of curvature of the pin-centre curve),
+    /// no material left at the root. Non-finite or non-positive sizes give
+    /// `RvdynError::Parameter`.
+    ///
+    /// ```
+    /// use rvdyn::geometry::{CycloidGeometry, cycloid::CycloidParams};
+    /// let g = CycloidGeometry::new(CycloidParams {
+    ///     pins: 24, eccentricity: 4.5e-3, pin_circle_radius: 0.150, pin_radius: 0.010,
+    ///     face_width: 0.040, d_rp: 0.0, d_rrp: 0.0, d_delta: 0.0,
+    /// }).unwrap();
+    /// assert_eq!(g.lobes(), 23);
+    /// assert!((g.k1() - 0.72).abs() < 1e-12);
+    /// ```
+    pub fn new(params: CycloidParams) -> Result<Self> {
+        let p = params;
+        if p.pins < 3 {
+            return Err(RvdynError::Geometry(format!(
+                "a cycloid drive needs at least 3 pins, got {}",
+                p.pins
+            )));
+        }
+        require_positive("eccentricity", p.eccentricity, "m")?;
+        require_positive("pin_circle_radius", p.pin_circle_radius, "m")?;
+        require_positive("pin_radius", p.pin_radius, "m")?;
+        require_positive("face_width", p.face_width, "m")?;
+        require_finite("d_rp", p.d_rp)?;
+        require_finite("d_rrp", p.d_rrp)?;
+        require_finite("d_delta", p.d_delta)?;
+        let zp = f64::from(p.pins);
+        let zc = zp - 1.0;
+        let gen_radius = p.pin_circle_radius + p.d_rp;
+        let gen_pin_radius = p.pin_radius + p.d_rrp;
+        require_positive("pin_circle_radius + d_rp", gen_radius, "m")?;
+        require_positive("pin_radius + d_rrp", gen_pin_radius, "m")?;
+        let k1 = p.eccentricity * zp / gen_radius;
+        if k1 >= 1.0 {
+            return Err(RvdynError::Geometry(format!(
+                "curtate ratio K1 = e*zp/(rp+d_rp) = {k1:.4} must be < 1 (the pin-centre curve \
+                 loops otherwise): reduce the eccentricity below {:.6e} m or enlarge the pin circle",
+                gen_radius / zp
+            )));
+        }
+        let spacing = p.pin_circle_radius * (PI / zp).sin();
+        if spacing <= p.pin_radius {
+            return Err(RvdynError::Geometry(format!(
+                "pins overlap: rp*sin(pi/zp) = {spacing:.6e} m must exceed the pin radius \
+                 {:.6e} m; use smaller pins, fewer pins or a larger pin circle",
+                p.pin_radius
+            )));
+        }
+        let min_convex_radius = min_convex_radius_of(k1, zp, gen_radius);
+        if gen_pin_radius >= min_convex_radius {
+            return Err(RvdynError::Geometry(format!(
+                "undercut: the generating pin radius rrp+d_rrp = {gen_pin_radius:.6e} m must be \
+                 below the minimum convex radius of curvature of the pin-centre curve \
+                 {min_convex_radius:.6e} m (the profile would form a cusp); use smaller pins or \
+                 a smaller curtate ratio K1"
+            )));
+        }
+        let root = gen_radius - p.eccentricity - gen_pin_radius;
+        require_non_negative("root radius rp+d_rp-e-rrp-d_rrp", root, "m").map_err(|_| {
+            RvdynError::Geometry(format!(
+                "no material at the tooth root: rp+d_rp-e-rrp-d_rrp = {root:.6e} m must be > 0"
+            ))
+        })?;
+        let mut g = Self {
+            params,
+            zp,
+            zc,
+            gen_radius,
+            gen_pin_radius,
+            k1,
+            min_convex_radius,
+            seed: ProfileSeed::empty(),
+        };
+        g.seed = ProfileSeed::build(&g, 48);
+        Ok(g)
+    }
+
+    /// The parameters this disc was built from.
+    pub fn params(&self) -> &CycloidParams {
+        &self.params
+    }
+    /// Number of pins `zp`.
+    pub fn pins(&self) -> u32 {
+        self.params.pins
+    }
+    /// Number of lobes `zc = zp - 1`.
+    pub fn lobes(&self) -> u32 {
+        self.params.pins - 1
+    }
+    /// Curtate ratio `K1 = e zp / (rp + d_rp)` of the ground profile (dimensionless).
+    pub fn k1(&self) -> f64 {
+        self.k1
+    }
+    /// Minimum convex radius of curvature of the pin-centre curve [m] (undercut limit).
+    pub fn min_convex_radius(&self) -> f64 {
+        self.min_convex_radius
+    }
+    /// Generating pin radius `rrp + d_rrp` [m]: the offset from the pin-centre curve to the profile.
+    pub fn generating_pin_radius(&self) -> f64 {
+        self.gen_pin_radius
+    }
+    /// Pitch radius of the disc `rc' = e zc` [m].
+    pub fn pitch_radius(&self) -> f64 {
+        self.params.eccentricity * self.zc
+    }
+    /// Angle of pin `j` (0-based; the paper's pin `j + 1`) in the fixed frame [rad].
+    pub fn pin_angle(&self, j: usize) -> f64 {
+        2.0 * PI * j as f64 / self.zp
+    }
+
+    /// Pin-centre curve and its first two derivatives at `phi` (unrotated disc frame).
+    #[inline]
+    pub(crate) fn jet(&self, phi: f64) -> CurveJet {
+        let (s1, c1) = phi.sin_cos();
+        let (sz, cz) = (self.zp * phi).sin_cos();
+        let r = self.gen_radius;
+        let e = self.params.eccentricity;
+        let ez = e * self.zp;
+        let ez2 = ez * self.zp;
+        CurveJet {
+            c: [r * c1 - e * cz, r * s1 - e * sz],
+            d1: [-r * s1 + ez * sz, r * c1 - ez * cz],
+            d2: [-r * c1 + ez2 * cz, -r * s1 + ez2 * sz],
+        }
+    }
+
+    /// Outward unit normal of the curve at `phi` from its tangent (unrotated disc frame).
+    #[inline]
+    pub(crate) fn normal_from_tangent(d1: [f64; 2]) -> [f64; 2] {
+        let len = d1[0].hypot(d1[1]);
+        [d1[1] / len, -d1[0] / len]
+    }
+
+    /// Rotate a disc-frame vector by the rotation modification `d_delta`.
+    #[inline]
+    pub(crate) fn apply_rotation_mod(&self, v: [f64; 2]) -> [f64; 2] {
+        if self.params.d_delta == 0.0 {
+            return v;
+        }
+        let (s, c) = self.params.d_delta.sin_cos();
+        [c * v[0] - s * v[1], s * v[0] + c * v[1]]
+    }
+
+    /// Undo the rotation modification on a disc-frame vector.
+    #[inline]
+    pub(crate) fn remove_rotation_mod(&self, v: [f64; 2]) -> [f64; 2] {
+        if self.params.d_delta == 0.0 {
+            return v;
+        }
+        let (s, c) = self.params.d_delta.sin_cos();
+        [c * v[0] + s * v[1], -s * v[0] + c * v[1]]
+    }
+
+    /// Point of the actual (ground) profile at curve parameter `phi`, disc frame [m].
+    ///
+    /// ```
+    /// # use rvdyn::geometry::{CycloidGeometry, cycloid::CycloidParams};
+    /// # let g = CycloidGeometry::new(CycloidParams { pins: 24, eccentricity: 4.5e-3,
+    /// #   pin_circle_radius: 0.15, pin_radius: 0.01, face_width: 0.04,
+    /// #   d_rp: 0.0, d_rrp: 0.0, d_delta: 0.0 }).unwrap();
+    /// let root = g.profile_point(0.0); // tooth root on +x: rp - e - rrp
+    /// assert!((root[0] - 0.1355).abs() < 1e-12 && root[1].abs() < 1e-15);
+    /// ```
+    pub fn profile_point(&self, phi: f64) -> [f64; 2] {
+        self.apply_rotation_mod(self.unrotated_profile_point(phi))
+    }
+
+    /// Profile point before the rotation modification is applied.
+    pub(crate) fn unrotated_profile_point(&self, phi: f64) -> [f64; 2] {
+        let j = self.jet(phi);
+        let n = Self::normal_from_tangent(j.d1);
+        let r = self.gen_pin_radius;
+        [j.c[0] - r * n[0], j.c[1] - r * n[1]]
+    }
+
+    /// Outward unit normal of the profile at `phi`, disc frame.
+    pub fn normal(&self, phi: f64) -> [f64; 2] {
+        let j = self.jet(phi);
+        self.apply_rotation_mod(Self::normal_from_tangent(j.d1))
+    }
+
+    /// Signed curvature of the pin-centre curve at `phi` [1/m] (positive convex).
+    pub fn centre_curve_curvature(&self, phi: f64) -> f64 {
+        let j = self.jet(phi);
+        let cross = j.d1[0] * j.d2[1] - j.d1[1] * j.d2[0];
+        let len = j.d1[0].hypot(j.d1[1]);
+        cross / (len * len * len)
+    }
+
+    /// Signed radius of curvature of the actual profile at `phi` [m]: positive where the
+    /// profile is convex (lobe flank and tip), negative where concave (around the root).
+    /// Equals `1/kappa_C - (rrp + d_rrp)`.
+    pub fn curvature_radius(&self, phi: f64) -> f64 {
+        1.0 / self.centre_curve_curvature(phi) - self.gen_pin_radius
+    }
+
+    /// Area [m^2] and polar second moment of area about the disc centre [m^4] of the solid
+    /// bounded by the profile (no holes). Green's theorem with the exact tangent
+    /// `P' = C' (1 - r kappa_C)`; the trapezoid rule on a periodic analytic integrand converges
+    /// geometrically, so `samples_per_lobe = 64` is already at round-off.
+    pub fn profile_area_moments(&self, samples_per_lobe: usize) -> (f64, f64) {
+        let n = samples_per_lobe.max(16) * self.lobes() as usize;
+        let h = 2.0 * PI / n as f64;
+        let (mut area, mut polar) = (0.0, 0.0);
+        for i in 0..n {
+            let phi = i as f64 * h;
+            let j = self.jet(phi);
+            let scale = 1.0 - self.gen_pin_radius * self.centre_curve_curvature(phi);
+            let p = self.unrotated_profile_point(phi);
+            let d = [j.d1[0] * scale, j.d1[1] * scale];
+            area += 0.5 * (p[0] * d[1] - p[1] * d[0]) * h;
+            polar += (p[0].powi(3) * d[1] - p[1].powi(3) * d[0]) / 3.0 * h;
+        }
+        (area, polar)
+    }
+}
+
+/// Minimum convex radius of curvature of the pin-centre curve [m].
+///
+/// The curvature depends on `c = cos(zc phi)` only:
+/// `kappa = [1 + zp K1^2 - K1 (1 + zp) c] / (R S^3)`, `S^2 = 1 + K1^2 - 2 K1 c`.
+fn min_convex_radius_of(k1: f64, zp: f64, r: f64) -> f64 {
+    let kappa = |c: f64| {
+        let s2 = 1.0 + k1 * k1 - 2.0 * k1 * c;
+        (1.0 + zp * k1 * k1 - k1 * (1.0 + zp) * c) / (r * s2 * s2.sqrt())
+    };
+    // Dense scan then golden-section refinement of the largest curvature.
+    let n = 4000;
+    let mut best = (-1.0, f64::NEG_INFINITY);
+    for i in 0..=n {
+        let c = -1.0 + 2.0 * i as f64 / n as f64;
+        let k = kappa(c);
+        if k > best.1 {
+            best = (c, k);
+        }
+    }
+    let (mut a, mut b) = ((best.0 - 2.0 / n as f64).max(-1.0), (best.0 + 2.0 / n as f64).min(1.0));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..60 {
+        let x1 = b - g * (b - a);
+        let x2 = a + g * (b - a);
+        if kappa(x1) > kappa(x2) {
+            b = x2;
+        } else {
+            a = x1;
+        }
+    }
+    let kmax = kappa(0.5 * (a + b)).max(best.1);
+    if kmax > 0.0 { 1.0 / kmax } else { f64::INFINITY }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    pub(crate) fn paper_params() -> CycloidParams {
+        CycloidParams {
+            pins: 24,
+            eccentricity: 4.5e-3,
+            pin_circle_radius: 0.150,
+            pin_radius: 0.010,
+            face_width: 0.040,
+            d_rp: 0.0,
+            d_rrp: 0.0,
+            d_delta: 0.0,
+        }
+    }
+
+    #[test]
+    fn root_and_tip_radii() {
+        let g = CycloidGeometry::new(paper_params()).unwrap();
+        let root = g.profile_point(0.0);
+        assert!((root[0] - (0.150 - 0.0045 - 0.010)).abs() < 1e-15);
+        let tip = g.profile_point(PI / 23.0);
+        let r_tip = tip[0].hypot(tip[1]);
+        assert!((r_tip - (0.150 + 0.0045 - 0.010)).abs() < 1e-14);
+    }
+
+    #[test]
+    fn min_convex_radius_matches_the_notes() {
+        // notes/physics.md 1.4: rho_min(convex) = 20.75 mm for the default geometry.
+        let g = CycloidGeometry::new(paper_params()).unwrap();
+        assert!((g.min_convex_radius() - 20.75e-3).abs() < 0.01e-3, "{}", g.min_convex_radius());
+        // Against a dense sampling of the curvature from the curve derivatives.
+        let mut best = f64::INFINITY;
+        for i in 0..200_000 {
+            let phi = 2.0 * PI * i as f64 / 200_000.0;
+            let k = g.centre_curve_curvature(phi);
+            if k > 0.0 {
+                best = best.min(1.0 / k);
+            }
+        }
+        assert!((best - g.min_convex_radius()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn root_is_concave_with_the_notes_radius() {
+        // notes/physics.md 1.4: profile radius at the root is -10.72 mm.
+        let g = CycloidGeometry::new(paper_params()).unwrap();
+        assert!((g.curvature_radius(0.0) + 10.72e-3).abs() < 0.005e-3);
+    }
+
+    #[test]
+    fn normal_is_unit_and_orthogonal_to_tangent() {
+        let g = CycloidGeometry::new(paper_params()).unwrap();
+        for i in 0..100 {
+            let phi = 0.0731 * i as f64;
+            let n = g.normal(phi);
+            assert!((n[0].hypot(n[1]) - 1.0).abs() < 1e-14);
+            let h = 1e-6;
+            let a = g.profile_point(phi - h);
+            let b = g.profile_point(phi + h);
+            let t = [b[0] - a[0], b[1] - a[1]];
+            let tl = t[0].hypot(t[1]);
+            assert!((t[0] * n[0] + t[1] * n[1]).abs() / tl < 1e-6);
+            // Outward: the normal points away from the centre on average at roots and tips.
+        }
+        let n0 = g.normal(0.0);
+        assert!(n0[0] > 0.99);
+    }
+
+    #[test]
+    fn each_rule_is_named() {
+        let mut p = paper_params();
+        p.pins = 2;
+        assert!(CycloidGeometry::new(p).unwrap_err().to_string().contains("at least 3 pins"));
+        let mut p = paper_params();
+        p.eccentricity = 7e-3; // K1 = 1.12
+        assert!(CycloidGeometry::new(p).unwrap_err().to_string().contains("curtate"));
+        let mut p = paper_params();
+        p.pin_radius = 0.0196; // rp sin(pi/24) = 19.58 mm
+        assert!(CycloidGeometry::new(p).unwrap_err().to_string().contains("overlap"));
+        let mut p = paper_params();
+        p.pin_radius = 0.0190; // below the overlap limit, above rho_min = 20.75 mm? no: use d_rrp
+        p.d_rrp = 0.002;
+        assert!(CycloidGeometry::new(p).unwrap_err().to_string().contains("undercut"));
+        let mut p = paper_params();
+        p.face_width = f64::NAN;
+        assert!(matches!(CycloidGeometry::new(p), Err(RvdynError::Parameter(_))));
+        let mut p = paper_params();
+        p.d_rp = f64::INFINITY;
+        assert!(matches!(CycloidGeometry::new(p), Err(RvdynError::Parameter(_))));
+    }
+}

@@ -1,0 +1,23 @@
+//! rvdyn: dynamics of RV cycloid planetary reducers.
+//!
+//! Pure-Rust core (no pyo3 outside [`python`], which is compiled only with the `python` feature).
+//! Folders by concern:
+//! - [`geometry`]: exact cycloid profile and pin gap, involute first stage, mass properties;
+//! - [`contact`]: contact stiffness (the paper's eqs. 5-11, corrected), Hertz line contact,
+//!   the ADAMS IMPACT law;
+//! - [`kinematics`]: transmission ratio, body speeds, operating point;
+//! - [`dynamics`]: scenes and the equations of motion;
+//! - [`solve`]: time integrators;
+//! - [`analysis`]: quasi-static load sharing and run summaries.
+//!
+//! Units are SI everywhere: m, kg, s, N, rad, Pa.
+
+pub mod contact;
+pub mod error;
+pub mod geometry;
+pub mod kinematics;
+
+#[cfg(feature = "python")]
+mod python;
+
+pub use error::{Result, RvdynError};
