@@ -12,10 +12,13 @@
 //!
 //! Units are SI everywhere: m, kg, s, N, rad, Pa.
 
+pub mod analysis;
 pub mod contact;
+pub mod dynamics;
 pub mod error;
 pub mod geometry;
 pub mod kinematics;
+pub mod solve;
 
 #[cfg(feature = "python")]
 mod python;

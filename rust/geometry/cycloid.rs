@@ -317,7 +317,10 @@ fn min_convex_radius_of(k1: f64, zp: f64, r: f64) -> f64 {
             best = (c, k);
         }
     }
-    let (mut a, mut b) = ((best.0 - 2.0 / n as f64).max(-1.0), (best.0 + 2.0 / n as f64).min(1.0));
+    let (mut a, mut b) = (
+        (best.0 - 2.0 / n as f64).max(-1.0),
+        (best.0 + 2.0 / n as f64).min(1.0),
+    );
     let g = 0.5 * (5f64.sqrt() - 1.0);
     for _ in 0..60 {
         let x1 = b - g * (b - a);
@@ -329,7 +332,11 @@ fn min_convex_radius_of(k1: f64, zp: f64, r: f64) -> f64 {
         }
     }
     let kmax = kappa(0.5 * (a + b)).max(best.1);
-    if kmax > 0.0 { 1.0 / kmax } else { f64::INFINITY }
+    if kmax > 0.0 {
+        1.0 / kmax
+    } else {
+        f64::INFINITY
+    }
 }
 
 #[cfg(test)]
@@ -363,7 +370,11 @@ pub(crate) mod tests {
     fn min_convex_radius_matches_the_notes() {
         // notes/physics.md 1.4: rho_min(convex) = 20.75 mm for the default geometry.
         let g = CycloidGeometry::new(paper_params()).unwrap();
-        assert!((g.min_convex_radius() - 20.75e-3).abs() < 0.01e-3, "{}", g.min_convex_radius());
+        assert!(
+            (g.min_convex_radius() - 20.75e-3).abs() < 0.01e-3,
+            "{}",
+            g.min_convex_radius()
+        );
         // Against a dense sampling of the curvature from the curve derivatives.
         let mut best = f64::INFINITY;
         for i in 0..200_000 {
@@ -406,22 +417,48 @@ pub(crate) mod tests {
     fn each_rule_is_named() {
         let mut p = paper_params();
         p.pins = 2;
-        assert!(CycloidGeometry::new(p).unwrap_err().to_string().contains("at least 3 pins"));
+        assert!(
+            CycloidGeometry::new(p)
+                .unwrap_err()
+                .to_string()
+                .contains("at least 3 pins")
+        );
         let mut p = paper_params();
         p.eccentricity = 7e-3; // K1 = 1.12
-        assert!(CycloidGeometry::new(p).unwrap_err().to_string().contains("curtate"));
+        assert!(
+            CycloidGeometry::new(p)
+                .unwrap_err()
+                .to_string()
+                .contains("curtate")
+        );
         let mut p = paper_params();
         p.pin_radius = 0.0196; // rp sin(pi/24) = 19.58 mm
-        assert!(CycloidGeometry::new(p).unwrap_err().to_string().contains("overlap"));
+        assert!(
+            CycloidGeometry::new(p)
+                .unwrap_err()
+                .to_string()
+                .contains("overlap")
+        );
         let mut p = paper_params();
         p.pin_radius = 0.0190; // below the overlap limit, above rho_min = 20.75 mm? no: use d_rrp
         p.d_rrp = 0.002;
-        assert!(CycloidGeometry::new(p).unwrap_err().to_string().contains("undercut"));
+        assert!(
+            CycloidGeometry::new(p)
+                .unwrap_err()
+                .to_string()
+                .contains("undercut")
+        );
         let mut p = paper_params();
         p.face_width = f64::NAN;
-        assert!(matches!(CycloidGeometry::new(p), Err(RvdynError::Parameter(_))));
+        assert!(matches!(
+            CycloidGeometry::new(p),
+            Err(RvdynError::Parameter(_))
+        ));
         let mut p = paper_params();
         p.d_rp = f64::INFINITY;
-        assert!(matches!(CycloidGeometry::new(p), Err(RvdynError::Parameter(_))));
+        assert!(matches!(
+            CycloidGeometry::new(p),
+            Err(RvdynError::Parameter(_))
+        ));
     }
 }

@@ -66,8 +66,18 @@ impl CycloidGeometry {
     /// let gap = g.gap(pin, centre, -psi / 23.0).unwrap();
     /// assert!(gap.gap.abs() < 1e-12);
     /// ```
-    pub fn gap(&self, pin_center: [f64; 2], disc_center: [f64; 2], disc_angle: f64) -> Result<PinGap> {
-        self.gap_with_pin_radius(pin_center, self.params().pin_radius, disc_center, disc_angle)
+    pub fn gap(
+        &self,
+        pin_center: [f64; 2],
+        disc_center: [f64; 2],
+        disc_angle: f64,
+    ) -> Result<PinGap> {
+        self.gap_with_pin_radius(
+            pin_center,
+            self.params().pin_radius,
+            disc_center,
+            disc_angle,
+        )
     }
 
     /// As [`CycloidGeometry::gap`] for a pin of another radius [m] (pin radius errors).
@@ -80,9 +90,10 @@ impl CycloidGeometry {
     ) -> Result<PinGap> {
         let p = self.to_local(pin_center, disc_center, disc_angle)?;
         require_positive("pin_radius", pin_radius, "m")?;
-        let seed = self.seed.seed(p).ok_or_else(|| {
-            RvdynError::Parameter("pin and disc positions must be finite".into())
-        })?;
+        let seed = self
+            .seed
+            .seed(p)
+            .ok_or_else(|| RvdynError::Parameter("pin and disc positions must be finite".into()))?;
         let foot = self.foot(p, seed).ok_or_else(|| self.no_foot(p))?;
         Ok(self.to_global(&foot, pin_radius, disc_center, disc_angle))
     }
@@ -135,7 +146,13 @@ impl CycloidGeometry {
                 let j = self.jet(phi);
                 let n = Self::normal_from_tangent(j.d1);
                 let dist = (p[0] - j.c[0]) * n[0] + (p[1] - j.c[1]) * n[1];
-                return Some(LocalFoot { phi, dist, normal: n, centre_point: j.c, iterations: it });
+                return Some(LocalFoot {
+                    phi,
+                    dist,
+                    normal: n,
+                    centre_point: j.c,
+                    iterations: it,
+                });
             }
         }
         None
@@ -242,7 +259,11 @@ mod tests {
         for _ in 0..200 {
             let m1 = lo + (hi - lo) / 3.0;
             let m2 = hi - (hi - lo) / 3.0;
-            if dist(m1) < dist(m2) { hi = m2 } else { lo = m1 }
+            if dist(m1) < dist(m2) {
+                hi = m2
+            } else {
+                lo = m1
+            }
         }
         let phi = 0.5 * (lo + hi);
         let q = world(phi);
@@ -262,7 +283,9 @@ mod tests {
         let mut worst: f64 = 0.0;
         let mut state = 12345u64;
         let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((state >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
         };
         for _ in 0..40 {
@@ -313,7 +336,10 @@ mod tests {
         }
         // Second-order remainder: ~3e-5 mm for 0.02 mm modifications (notes 1.3).
         assert!(worst < 1e-7, "worst deviation from first order {worst:e} m");
-        assert!(worst > 1e-10, "the exact gap should differ from first order at second order");
+        assert!(
+            worst > 1e-10,
+            "the exact gap should differ from first order at second order"
+        );
     }
 
     #[test]
@@ -335,7 +361,10 @@ mod tests {
     #[test]
     fn non_finite_input_is_rejected() {
         let g = CycloidGeometry::new(paper_params()).unwrap();
-        assert!(matches!(g.gap([f64::NAN, 0.0], [0.0, 0.0], 0.0), Err(RvdynError::Parameter(_))));
+        assert!(matches!(
+            g.gap([f64::NAN, 0.0], [0.0, 0.0], 0.0),
+            Err(RvdynError::Parameter(_))
+        ));
         assert!(g.gap([0.15, 0.0], [0.0, 0.0], f64::INFINITY).is_err());
     }
 }

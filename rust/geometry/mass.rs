@@ -78,13 +78,19 @@ pub fn disc_mass_properties(
         )));
     }
     let t = geometry.params().face_width * density;
-    Ok(MassProperties { mass: a * t, inertia: j * t })
+    Ok(MassProperties {
+        mass: a * t,
+        inertia: j * t,
+    })
 }
 
 /// Solid cylinder of radius `r` [m] and length `l` [m]: mass and inertia about its axis.
 pub fn solid_cylinder(r: f64, l: f64, density: f64) -> MassProperties {
     let m = density * PI * r * r * l;
-    MassProperties { mass: m, inertia: 0.5 * m * r * r }
+    MassProperties {
+        mass: m,
+        inertia: 0.5 * m * r * r,
+    }
 }
 
 #[cfg(test)]

@@ -20,7 +20,10 @@ pub struct ProfileSeed {
 
 impl ProfileSeed {
     pub(crate) fn empty() -> Self {
-        Self { polyline: None, dphi: 0.0 }
+        Self {
+            polyline: None,
+            dphi: 0.0,
+        }
     }
 
     /// Sample the profile with `per_lobe` vertices per lobe.
@@ -34,7 +37,10 @@ impl ProfileSeed {
             })
             .collect();
         let indices: Vec<[u32; 2]> = (0..n as u32).map(|i| [i, (i + 1) % n as u32]).collect();
-        Self { polyline: Some(Polyline::new(vertices, Some(indices))), dphi }
+        Self {
+            polyline: Some(Polyline::new(vertices, Some(indices))),
+            dphi,
+        }
     }
 
     /// Curve parameter of the polyline point nearest to `point` (unrotated disc frame), or

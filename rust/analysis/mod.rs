@@ -1,0 +1,1 @@
+//! Analysis of runs: quasi-static load sharing.

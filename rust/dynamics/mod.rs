@@ -1,0 +1,14 @@
+//! Scenes, the equations of motion and the simulation driver.
+
+pub mod drive;
+pub mod record;
+pub mod rigid;
+pub mod scene;
+pub mod simulate;
+pub mod sink;
+pub mod system;
+
+pub use record::Recording;
+pub use rigid::RigidModel;
+pub use scene::Scene;
+pub use simulate::{RunControl, SimOptions, simulate};

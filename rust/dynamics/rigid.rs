@@ -1,0 +1,452 @@
+//! Rigid-joint model in reduced coordinates (design.md section 5).
+//!
+//! Coordinates `x = [th_c, alpha, th_s]`: carrier angle, absolute crank angle (all cranks equal
+//! when the joints are ideal), sun angle. Disc `k` (eccentric phase `a_k`) has its centre at
+//! `O_k = e (cos(alpha + a_k), sin(alpha + a_k))` and turns with the carrier,
+//! `theta_k = th_c - a_k / zc` (the half-lobe offset of the second disc). The mass matrix is
+//! diagonal and constant in these coordinates:
+//! `M_cc = J_c + J_load + n_cr m_cr r_cr^2 + sum J_d`, `M_aa = n_cr J_cr + sum m_d e^2`,
+//! `M_ss = J_s`. Generalised forces come from virtual work: a pin force `-F N` at the profile
+//! point `X` of disc `k` gives `Q_c = -F N.(z x (X - O_k))`, `Q_a = -F N.(z x O_k)`; a mesh
+//! force `F` with deflection `delta = r_bs (th_s - th_c) + r_bp (alpha - th_c)` gives
+//! `Q = -F grad(delta)`. Prescribed coordinates are taken from the drive; the reaction
+//! `M_ii a_i - Q_i` on them is the input torque.
+
+use crate::contact::ImpactLaw;
+use crate::dynamics::drive::DriveProfile;
+use crate::dynamics::scene::{Initial, Joints, Load, Scene};
+use crate::dynamics::sink::ContactSink;
+use crate::error::{Result, RvdynError};
+use crate::geometry::CycloidGeometry;
+use crate::geometry::mass::{DiscHoles, MassProperties, disc_mass_properties, solid_cylinder};
+
+/// Index of the carrier angle in the full coordinate vector.
+pub const CARRIER: usize = 0;
+/// Index of the absolute crank angle.
+pub const CRANK: usize = 1;
+/// Index of the sun angle.
+pub const SUN: usize = 2;
+
+/// One disc of the model.
+#[derive(Debug, Clone)]
+pub struct DiscModel {
+    pub geometry: CycloidGeometry,
+    /// Eccentric phase on the crank [rad].
+    pub phase: f64,
+    /// Disc angle offset from the carrier angle, `-phase / zc` [rad].
+    pub angle_offset: f64,
+}
+
+/// One fixed pin.
+#[derive(Debug, Clone, Copy)]
+pub struct PinModel {
+    pub centre: [f64; 2],
+    pub radius: f64,
+    /// Nominal angle of the pin on the pin circle [rad] (the kinematic seed of its contact).
+    pub angle: f64,
+}
+
+/// The sun/planet meshes of the first stage.
+#[derive(Debug, Clone, Copy)]
+pub struct MeshModel {
+    pub sun_base_radius: f64,
+    pub planet_base_radius: f64,
+    /// Total backlash along the line of action [m].
+    pub backlash: f64,
+    pub law: ImpactLaw,
+    pub count: usize,
+}
+
+/// Mass properties actually used by a model (computed or from the scene).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModelInertias {
+    pub sun: MassProperties,
+    pub crank: MassProperties,
+    pub disc: MassProperties,
+    pub carrier: MassProperties,
+    pub load_inertia: f64,
+}
+
+/// Generalised forces and power flows from one evaluation.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Forces {
+    /// Generalised forces on `[th_c, alpha, th_s]` [N m].
+    pub q: [f64; 3],
+    /// Power dissipated by contact damping [W].
+    pub dissipation: f64,
+    /// Elastic energy stored in the contacts [J] (only when asked for).
+    pub potential: f64,
+}
+
+/// The rigid-joint reducer model.
+#[derive(Debug, Clone)]
+pub struct RigidModel {
+    pub discs: Vec<DiscModel>,
+    pub pins: Vec<PinModel>,
+    pub pin_law: ImpactLaw,
+    pub mesh: Option<MeshModel>,
+    pub cranks: usize,
+    pub crank_radius: f64,
+    pub eccentricity: f64,
+    pub inertias: ModelInertias,
+    /// Diagonal generalised mass of `[th_c, alpha, th_s]`.
+    pub mass: [f64; 3],
+    /// Free coordinates (indices into the full vector).
+    pub free: Vec<usize>,
+    /// The prescribed coordinate, if the drive is a speed.
+    pub prescribed: Option<usize>,
+    /// The coordinate the drive acts on (sun, or crank without a first stage).
+    pub input: usize,
+    pub drive: DriveProfile,
+    pub load: Load,
+    pub ratio: f64,
+    pub initial: Initial,
+    /// Lever length per full coordinate [m per rad], turning angle errors into displacements.
+    pub length_scale: [f64; 3],
+    /// Penetration beyond which a run is declared unstable [m].
+    pub max_penetration: f64,
+}
+
+impl RigidModel {
+    /// Build the model of a validated scene.
+    pub fn new(scene: &Scene) -> Result<Self> {
+        scene.validate()?;
+        if !matches!(scene.joints, Joints::Rigid) {
+            return Err(RvdynError::Scene(
+                "this model needs joints.kind = \"rigid\"; the compliant model is built by \
+                 CompliantModel"
+                    .into(),
+            ));
+        }
+        let cyc = scene.cycloid;
+        let zp = cyc.pins as usize;
+        let zc = (cyc.pins - 1) as f64;
+        let mut discs = Vec::with_capacity(scene.discs.len());
+        for (k, d) in scene.discs.iter().enumerate() {
+            discs.push(DiscModel {
+                geometry: CycloidGeometry::new(scene.disc_params(k))?,
+                phase: d.phase,
+                angle_offset: -d.phase / zc,
+            });
+        }
+        let pins = (0..zp)
+            .map(|j| {
+                let th = std::f64::consts::TAU * j as f64 / zp as f64;
+                let dp = scene
+                    .pin_errors
+                    .position
+                    .get(j)
+                    .copied()
+                    .unwrap_or([0.0, 0.0]);
+                let dr = scene.pin_errors.radius.get(j).copied().unwrap_or(0.0);
+                PinModel {
+                    centre: [
+                        cyc.pin_circle_radius * th.cos() + dp[0],
+                        cyc.pin_circle_radius * th.sin() + dp[1],
+                    ],
+                    radius: cyc.pin_radius + dr,
+                    angle: th,
+                }
+            })
+            .collect();
+        let pin_law = scene.contact.pin.law(cyc.face_width)?;
+        let mesh = match &scene.stage1 {
+            Some(s) => Some(MeshModel {
+                sun_base_radius: s.sun_base_radius(),
+                planet_base_radius: s.planet_base_radius(),
+                backlash: s.backlash,
+                law: scene.contact.mesh.law(s.face_width)?,
+                count: s.planets as usize,
+            }),
+            None => None,
+        };
+        let crank_radius = scene.stage1.as_ref().map_or(0.09, |s| s.centre_distance());
+        let inertias = default_inertias(scene, &discs[0].geometry, crank_radius)?;
+        let n_cr = f64::from(scene.cranks);
+        let e = cyc.eccentricity;
+        let nd = discs.len() as f64;
+        let mass = [
+            inertias.carrier.inertia
+                + inertias.load_inertia
+                + n_cr * inertias.crank.mass * crank_radius * crank_radius
+                + nd * inertias.disc.inertia,
+            n_cr * inertias.crank.inertia + nd * inertias.disc.mass * e * e,
+            inertias.sun.inertia,
+        ];
+        let input = if mesh.is_some() { SUN } else { CRANK };
+        let drive = DriveProfile::new(&scene.drive);
+        let (free, prescribed) = match (drive.is_speed(), mesh.is_some()) {
+            (true, true) => (vec![CARRIER, CRANK], Some(SUN)),
+            (false, true) => (vec![CARRIER, CRANK, SUN], None),
+            (true, false) => (vec![CARRIER], Some(CRANK)),
+            (false, false) => (vec![CARRIER, CRANK], None),
+        };
+        let rp = cyc.pin_circle_radius;
+        let length_scale = [rp, e, mesh.map_or(0.0, |m| m.sun_base_radius)];
+        Ok(Self {
+            discs,
+            pins,
+            pin_law,
+            mesh,
+            cranks: scene.cranks as usize,
+            crank_radius,
+            eccentricity: e,
+            inertias,
+            mass,
+            free,
+            prescribed,
+            input,
+            drive,
+            load: scene.load.clone(),
+            ratio: scene.ratio(),
+            initial: scene.initial,
+            length_scale,
+            // A tenth of the pin radius is far beyond any elastic approach of steel.
+            max_penetration: 0.1 * cyc.pin_radius,
+        })
+    }
+
+    /// Initial full state `(x, v)` at t = 0: kinematic pose, at rest or at kinematic speed.
+    pub fn initial_state(&self) -> ([f64; 3], [f64; 3]) {
+        let x = [0.0, 0.0, 0.0];
+        let mut v = [0.0; 3];
+        if self.initial == Initial::Steady {
+            let w_in = self.drive.full_speed();
+            let zc = self.zc();
+            let carrier = w_in / self.ratio;
+            v = [
+                carrier,
+                -zc * carrier,
+                if self.mesh.is_some() { w_in } else { 0.0 },
+            ];
+        }
+        if let Some(p) = self.prescribed {
+            let (ang, spd, _) = self.drive.motion(0.0);
+            let mut x = x;
+            x[p] = ang;
+            v[p] = spd;
+            return (x, v);
+        }
+        (x, v)
+    }
+
+    /// Number of lobes `zc`.
+    pub fn zc(&self) -> f64 {
+        f64::from(self.discs[0].geometry.lobes())
+    }
+
+    /// Overwrite the prescribed coordinate of a full state with the drive at time `t`;
+    /// returns its acceleration.
+    #[inline]
+    pub fn apply_drive(&self, t: f64, x: &mut [f64; 3], v: &mut [f64; 3]) -> f64 {
+        match self.prescribed {
+            Some(p) => {
+                let (ang, spd, acc) = self.drive.motion(t);
+                x[p] = ang;
+                v[p] = spd;
+                acc
+            }
+            None => 0.0,
+        }
+    }
+
+    /// Disc `k` centre [m] and angle [rad] for the full coordinates `x`.
+    #[inline]
+    pub fn disc_pose(&self, k: usize, x: &[f64; 3]) -> ([f64; 2], f64) {
+        let d = &self.discs[k];
+        let (s, c) = (x[CRANK] + d.phase).sin_cos();
+        (
+            [self.eccentricity * c, self.eccentricity * s],
+            x[CARRIER] + d.angle_offset,
+        )
+    }
+
+    /// Generalised forces at `(t, x, v)` (full coordinates), reporting every contact to `sink`.
+    ///
+    /// Fails with `SimulationError` if a state is not finite or a penetration exceeds the
+    /// physical bound, and with `ConvergenceError` if an exact gap cannot be found.
+    pub fn forces<S: ContactSink>(
+        &self,
+        t: f64,
+        x: &[f64; 3],
+        v: &[f64; 3],
+        sink: &mut S,
+    ) -> Result<Forces> {
+        let mut out = Forces::default();
+        let want_energy = sink.wants_energy();
+        let vc = v[CARRIER];
+        let va = v[CRANK];
+        for (k, d) in self.discs.iter().enumerate() {
+            let (o, th) = self.disc_pose(k, x);
+            let (s, c) = th.sin_cos();
+            let rot_mod = d.geometry.params().d_delta;
+            let r_gen = d.geometry.generating_pin_radius();
+            for (j, pin) in self.pins.iter().enumerate() {
+                // Pin centre in the disc frame.
+                let dp = [pin.centre[0] - o[0], pin.centre[1] - o[1]];
+                let local = d
+                    .geometry
+                    .remove_rotation_mod([c * dp[0] + s * dp[1], -s * dp[0] + c * dp[1]]);
+                let seed = pin.angle - th - rot_mod;
+                let foot = d.geometry.foot_with_fallback(local, seed).ok_or_else(|| {
+                    RvdynError::Convergence(format!(
+                        "exact gap of pin {} on disc {k} not found at t = {t:.6e} s: the disc is \
+                         far from its kinematic pose (the run has gone unstable; reduce the step)",
+                        j + 1
+                    ))
+                })?;
+                let gap = foot.dist + r_gen - pin.radius;
+                if gap >= 0.0 {
+                    sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
+                    continue;
+                }
+                let pen = -gap;
+                if !(pen < self.max_penetration) {
+                    return Err(penetration_error(
+                        t,
+                        pen,
+                        self.max_penetration,
+                        &format!("pin {} on disc {k}", j + 1),
+                    ));
+                }
+                // Normal and contact point in the fixed frame.
+                let nl = d.geometry.apply_rotation_mod(foot.normal);
+                let n = [c * nl[0] - s * nl[1], s * nl[0] + c * nl[1]];
+                let pl = d.geometry.apply_rotation_mod([
+                    foot.centre_point[0] - r_gen * foot.normal[0],
+                    foot.centre_point[1] - r_gen * foot.normal[1],
+                ]);
+                let rel = [c * pl[0] - s * pl[1], s * pl[0] + c * pl[1]];
+                // Lever of N about the disc centre and about the axis (through O_k).
+                let lever_c = rel[0] * n[1] - rel[1] * n[0];
+                let lever_a = o[0] * n[1] - o[1] * n[0];
+                let pen_rate = lever_c * vc + lever_a * va;
+                let f = self.pin_law.force(pen, pen_rate);
+                out.q[CARRIER] -= f * lever_c;
+                out.q[CRANK] -= f * lever_a;
+                let elastic = self.pin_law.elastic_force(pen);
+                out.dissipation += (f - elastic) * pen_rate;
+                if want_energy {
+                    out.potential += self.pin_law.elastic_energy(pen);
+                }
+                let point = [o[0] + rel[0], o[1] + rel[1]];
+                // Moment of the pin's force (-f n) on the disc about the disc centre.
+                sink.pin(k, j, f, pen, -f * lever_c, point, n);
+            }
+        }
+        if let Some(m) = &self.mesh {
+            let delta = m.sun_base_radius * (x[SUN] - x[CARRIER])
+                + m.planet_base_radius * (x[CRANK] - x[CARRIER]);
+            let rate = m.sun_base_radius * (v[SUN] - vc) + m.planet_base_radius * (va - vc);
+            let half = 0.5 * m.backlash;
+            let (f, elastic, pen, pen_rate) = if delta > half {
+                let p = delta - half;
+                (m.law.force(p, rate), m.law.elastic_force(p), p, rate)
+            } else if delta < -half {
+                let p = -delta - half;
+                (-m.law.force(p, -rate), -m.law.elastic_force(p), p, -rate)
+            } else {
+                (0.0, 0.0, 0.0, 0.0)
+            };
+            if pen > 0.0 {
+                if !(pen < self.max_penetration) {
+                    return Err(penetration_error(
+                        t,
+                        pen,
+                        self.max_penetration,
+                        "a sun/planet mesh",
+                    ));
+                }
+                let nf = m.count as f64;
+                out.q[CARRIER] += nf * f * (m.sun_base_radius + m.planet_base_radius);
+                out.q[CRANK] -= nf * f * m.planet_base_radius;
+                out.q[SUN] -= nf * f * m.sun_base_radius;
+                out.dissipation += nf * (f.abs() - elastic.abs()) * pen_rate;
+                if want_energy {
+                    out.potential += nf * m.law.elastic_energy(pen);
+                }
+            }
+            for i in 0..m.count {
+                sink.mesh(i, f, delta);
+            }
+        }
+        out.q[CARRIER] -= self.load.torque(t);
+        if let Some(tq) = self.drive.torque(t) {
+            out.q[self.input] += tq;
+        }
+        if !out.q.iter().all(|v| v.is_finite()) {
+            return Err(RvdynError::Simulation(format!(
+                "non-finite generalised force at t = {t:.6e} s: the integration has diverged; \
+                 reduce the step (dt) or the tolerances, or use the implicit integrator"
+            )));
+        }
+        Ok(out)
+    }
+
+    /// Kinetic energy of the free bodies [J] (the prescribed input is a driver, not counted).
+    pub fn kinetic_energy(&self, v: &[f64; 3]) -> f64 {
+        (0..3)
+            .filter(|i| Some(*i) != self.prescribed && (*i != SUN || self.mesh.is_some()))
+            .map(|i| 0.5 * self.mass[i] * v[i] * v[i])
+            .sum()
+    }
+}
+
+fn penetration_error(t: f64, pen: f64, bound: f64, what: &str) -> RvdynError {
+    RvdynError::Simulation(format!(
+        "penetration {pen:.3e} m of {what} at t = {t:.6e} s exceeds the physical bound \
+         {bound:.3e} m: the run has gone unstable; reduce the step (dt) or tolerances, or use \
+         the implicit integrator"
+    ))
+}
+
+/// Mass properties from the scene or from simple steel solids (stated in each line).
+fn default_inertias(
+    scene: &Scene,
+    disc: &CycloidGeometry,
+    crank_radius: f64,
+) -> Result<ModelInertias> {
+    let rho = scene.density;
+    let i = &scene.inertias;
+    let (sun_r, planet_r, gear_w) = scene.stage1.as_ref().map_or((0.027, 0.063, 0.03), |s| {
+        (s.sun_pitch_radius(), s.planet_pitch_radius(), s.face_width)
+    });
+    // Sun: gear cylinder at its pitch radius, plus a 20 mm radius, 150 mm input shaft.
+    let sun = i.sun.unwrap_or_else(|| {
+        add(
+            solid_cylinder(sun_r, gear_w, rho),
+            solid_cylinder(0.020, 0.150, rho),
+        )
+    });
+    // Crank: planet gear cylinder at its pitch radius, plus a 25 mm radius, 150 mm crankshaft.
+    let crank = i.crank.unwrap_or_else(|| {
+        add(
+            solid_cylinder(planet_r, gear_w, rho),
+            solid_cylinder(0.025, 0.150, rho),
+        )
+    });
+    let disc_mp = match i.disc {
+        Some(d) => d,
+        None => disc_mass_properties(disc, &DiscHoles::paper(), rho)?,
+    };
+    // Carrier: two end plates of radius rp - rrp - 10 mm, 30 mm thick.
+    let plate_r = scene.cycloid.pin_circle_radius - scene.cycloid.pin_radius - 0.010;
+    let carrier = i.carrier.unwrap_or_else(|| {
+        let p = solid_cylinder(plate_r.max(crank_radius), 0.030, rho);
+        add(p, p)
+    });
+    Ok(ModelInertias {
+        sun,
+        crank,
+        disc: disc_mp,
+        carrier,
+        load_inertia: i.load_inertia,
+    })
+}
+
+fn add(a: MassProperties, b: MassProperties) -> MassProperties {
+    MassProperties {
+        mass: a.mass + b.mass,
+        inertia: a.inertia + b.inertia,
+    }
+}

@@ -1,0 +1,655 @@
+//! A reducer scene: everything a dynamic run needs, serialisable to JSON and TOML.
+//!
+//! Every field is SI. Optional fields (`None`) are computed from the geometry when the model is
+//! built. [`Scene::paper`] is the default scene of design.md section 7.
+
+use crate::contact::ImpactLaw;
+use crate::error::{Result, RvdynError};
+use crate::geometry::cycloid::CycloidParams;
+use crate::geometry::involute::InvoluteStage;
+use crate::geometry::mass::MassProperties;
+use crate::kinematics::operating_point;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// One cycloid disc on the crank eccentrics.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiscSpec {
+    /// Phase of this disc's eccentric on the crank [rad] (0 and pi for the two-disc RV).
+    pub phase: f64,
+    /// Profile modifications of this disc [m, m, rad]; overrides the scene's `cycloid` values.
+    #[serde(default)]
+    pub d_rp: Option<f64>,
+    #[serde(default)]
+    pub d_rrp: Option<f64>,
+    #[serde(default)]
+    pub d_delta: Option<f64>,
+}
+
+/// Pin manufacturing errors (optional, per pin; index j is the paper's pin j+1).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PinErrors {
+    /// Position error of each pin centre, (dx, dy) in the fixed frame [m].
+    #[serde(default)]
+    pub position: Vec<[f64; 2]>,
+    /// Radius error of each pin [m] (positive = larger pin).
+    #[serde(default)]
+    pub radius: Vec<f64>,
+}
+
+/// Mass properties of the bodies; `None` = computed from the geometry (steel).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Inertias {
+    /// Sun gear and input shaft (inertia about the reducer axis).
+    #[serde(default)]
+    pub sun: Option<MassProperties>,
+    /// One crankshaft with its planet gear and eccentrics (inertia about the crank axis).
+    #[serde(default)]
+    pub crank: Option<MassProperties>,
+    /// One cycloid disc (inertia about its centre).
+    #[serde(default)]
+    pub disc: Option<MassProperties>,
+    /// Carrier (output) with everything bolted to it (inertia about the reducer axis).
+    #[serde(default)]
+    pub carrier: Option<MassProperties>,
+    /// Extra load inertia on the output [kg m^2].
+    #[serde(default)]
+    pub load_inertia: f64,
+}
+
+/// A bearing spring-damper (compliant joints).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bearing {
+    /// Radial stiffness [N/m].
+    pub stiffness: f64,
+    /// Radial damping [N s/m].
+    pub damping: f64,
+    /// Radial clearance [m].
+    #[serde(default)]
+    pub clearance: f64,
+}
+
+/// Crank-eccentric/disc and crank/carrier bearings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Joints {
+    /// Ideal joints (the paper): the discs move exactly with the cranks; DOFs carrier, crank.
+    Rigid,
+    /// Spring-damper bearings: disc translations and rotations, crank translations are DOFs.
+    Compliant {
+        /// Needle bearing between each eccentric and its disc hole.
+        eccentric_bearing: Bearing,
+        /// Bearing between each crankshaft and the carrier.
+        crank_bearing: Bearing,
+    },
+}
+
+/// Contact law of one contact family.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ContactLawSpec {
+    /// ADAMS IMPACT: `F = k x^e + STEP(x, 0, 0, depth, cmax) xdot`, `F >= 0`.
+    Impact {
+        /// k [N/m^exponent].
+        stiffness: f64,
+        exponent: f64,
+        /// cmax [N s/m].
+        max_damping: f64,
+        /// Penetration at which the full damping acts [m].
+        damping_depth: f64,
+    },
+    /// Steel line contact from the face width (Palmgren, Harris: `delta = 3.84e-5 Q^0.9 /
+    /// l^0.8` in mm and N), written as `F = K x^(10/9)` plus the same damping ramp.
+    Palmgren {
+        /// cmax [N s/m].
+        max_damping: f64,
+        /// Penetration at which the full damping acts [m].
+        damping_depth: f64,
+    },
+}
+
+impl ContactLawSpec {
+    /// The paper's IMPACT parameters (k = 3.988e5 N/mm^1.5, e = 1.5, cmax = 100 N s/mm,
+    /// d = 0.01 mm) in SI.
+    pub fn paper() -> Self {
+        let l = ImpactLaw::paper();
+        ContactLawSpec::Impact {
+            stiffness: l.stiffness,
+            exponent: l.exponent,
+            max_damping: l.max_damping,
+            damping_depth: l.damping_depth,
+        }
+    }
+
+    /// The force law for a contact of length `face_width` [m].
+    pub fn law(&self, face_width: f64) -> Result<ImpactLaw> {
+        match *self {
+            ContactLawSpec::Impact {
+                stiffness,
+                exponent,
+                max_damping,
+                damping_depth,
+            } => ImpactLaw::new(stiffness, exponent, max_damping, damping_depth),
+            ContactLawSpec::Palmgren {
+                max_damping,
+                damping_depth,
+            } => {
+                // delta_mm = 3.84e-5 F^0.9 / l_mm^0.8  ->  F = (1000 delta l_mm^0.8 / 3.84e-5)^(1/0.9)
+                let l_mm = face_width * 1e3;
+                let k = (1e3 * l_mm.powf(0.8) / 3.84e-5).powf(1.0 / 0.9);
+                ImpactLaw::new(k, 1.0 / 0.9, max_damping, damping_depth)
+            }
+        }
+    }
+}
+
+/// Contact laws per family.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactLaws {
+    /// Pin / cycloid profile contacts.
+    pub pin: ContactLawSpec,
+    /// Sun / planet meshes (along the line of action).
+    pub mesh: ContactLawSpec,
+}
+
+/// How the input starts.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StartKind {
+    /// Full speed from t = 0 (the paper: an impact at start).
+    Step,
+    /// Smooth cubic ramp from 0 to full speed over `ramp_time`.
+    Ramp,
+}
+
+/// The drive on the input (sun, or the cranks when there is no first stage).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Drive {
+    /// Prescribed input speed [rad/s].
+    Speed {
+        speed: f64,
+        start: StartKind,
+        /// Ramp duration [s] (for `start = "ramp"`).
+        #[serde(default)]
+        ramp_time: f64,
+    },
+    /// Prescribed input torque [N m] (the input becomes a degree of freedom).
+    Torque {
+        torque: f64,
+        #[serde(default)]
+        ramp_time: f64,
+    },
+}
+
+/// Load torque on the carrier (acts against positive, counter-clockwise output rotation).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Load {
+    /// No load.
+    Idle,
+    /// Constant torque [N m] from t = 0.
+    Constant { torque: f64 },
+    /// `before` [N m] until `time` [s], then `after`.
+    Step { before: f64, after: f64, time: f64 },
+    /// Piecewise-linear table of (t [s], torque [N m]), held constant outside.
+    Table { points: Vec<[f64; 2]> },
+}
+
+impl Load {
+    /// Load torque at time `t` [N m].
+    pub fn torque(&self, t: f64) -> f64 {
+        match self {
+            Load::Idle => 0.0,
+            Load::Constant { torque } => *torque,
+            Load::Step {
+                before,
+                after,
+                time,
+            } => {
+                if t < *time {
+                    *before
+                } else {
+                    *after
+                }
+            }
+            Load::Table { points } => table_value(points, t),
+        }
+    }
+}
+
+fn table_value(points: &[[f64; 2]], t: f64) -> f64 {
+    match points {
+        [] => 0.0,
+        [only] => only[1],
+        _ => {
+            if t <= points[0][0] {
+                return points[0][1];
+            }
+            for w in points.windows(2) {
+                if t <= w[1][0] {
+                    let s = (t - w[0][0]) / (w[1][0] - w[0][0]);
+                    return w[0][1] + s * (w[1][1] - w[0][1]);
+                }
+            }
+            points[points.len() - 1][1]
+        }
+    }
+}
+
+/// Initial state.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Initial {
+    /// Everything at rest in the kinematic pose (the paper's start).
+    Rest,
+    /// Every body at its kinematic speed for the drive's full input speed.
+    Steady,
+}
+
+/// A complete reducer description.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// A label for reports.
+    #[serde(default)]
+    pub name: String,
+    /// First (involute) stage; `None` = single-stage cycloid drive driven at the cranks.
+    #[serde(default)]
+    pub stage1: Option<InvoluteStage>,
+    /// Cycloid disc geometry and default modifications.
+    pub cycloid: CycloidParams,
+    /// The discs (one or two).
+    pub discs: Vec<DiscSpec>,
+    /// Number of crankshafts (3 in the paper's RV).
+    pub cranks: u32,
+    /// Pin manufacturing errors.
+    #[serde(default)]
+    pub pin_errors: PinErrors,
+    /// Material density for computed inertias [kg/m^3].
+    pub density: f64,
+    #[serde(default)]
+    pub inertias: Inertias,
+    pub joints: Joints,
+    pub contact: ContactLaws,
+    pub drive: Drive,
+    pub load: Load,
+    pub initial: Initial,
+}
+
+/// The paper's input speed, 8328 deg/s [rad/s].
+pub const PAPER_INPUT_SPEED: f64 = 8328.0 * PI / 180.0;
+/// The paper's power, 112 kW [W].
+pub const PAPER_POWER: f64 = 112e3;
+/// The paper's printed output torque [N m] (inconsistent with 112 kW: erratum 3).
+pub const PAPER_PRINTED_LOAD: f64 = 4024.9;
+
+impl Scene {
+    /// The default scene of design.md section 7 with the chosen load case: `"idle"`,
+    /// `"paper"` (the printed 4024.9 N m) or `"rated"` (43.9 kN m = 57 x 770.6 N m, lossless
+    /// 112 kW at 8328 deg/s).
+    pub fn paper(load: &str) -> Result<Self> {
+        let load = match load {
+            "idle" => Load::Idle,
+            "paper" => Load::Constant {
+                torque: PAPER_PRINTED_LOAD,
+            },
+            "rated" => {
+                let op = operating_point(PAPER_POWER, PAPER_INPUT_SPEED, 57.0)?;
+                Load::Constant {
+                    torque: op.output_torque,
+                }
+            }
+            other => {
+                return Err(RvdynError::Scene(format!(
+                    "unknown load case {other:?}: choose \"idle\", \"paper\" (4024.9 N m as \
+                     printed) or \"rated\" (43.9 kN m, consistent with 112 kW)"
+                )));
+            }
+        };
+        Ok(Scene {
+            name: "paper".into(),
+            stage1: Some(paper_stage1()?),
+            cycloid: CycloidParams {
+                pins: 24,
+                eccentricity: 4.5e-3,
+                pin_circle_radius: 0.150,
+                pin_radius: 0.010,
+                face_width: 0.040,
+                d_rp: 0.0,
+                d_rrp: 0.0,
+                d_delta: 0.0,
+            },
+            discs: vec![
+                DiscSpec {
+                    phase: 0.0,
+                    d_rp: None,
+                    d_rrp: None,
+                    d_delta: None,
+                },
+                DiscSpec {
+                    phase: PI,
+                    d_rp: None,
+                    d_rrp: None,
+                    d_delta: None,
+                },
+            ],
+            cranks: 3,
+            pin_errors: PinErrors::default(),
+            density: crate::geometry::mass::STEEL_DENSITY,
+            inertias: Inertias::default(),
+            joints: Joints::Rigid,
+            contact: ContactLaws {
+                pin: ContactLawSpec::paper(),
+                mesh: ContactLawSpec::paper(),
+            },
+            drive: Drive::Speed {
+                speed: PAPER_INPUT_SPEED,
+                start: StartKind::Step,
+                ramp_time: 0.0,
+            },
+            load,
+            initial: Initial::Rest,
+        })
+    }
+
+    /// Parse a scene from JSON text.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let s: Scene = serde_json::from_str(text)
+            .map_err(|e| RvdynError::Scene(format!("invalid scene JSON: {e}")))?;
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Serialise to pretty JSON.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(self)
+            .map_err(|e| RvdynError::Scene(format!("scene cannot be written as JSON: {e}")))
+    }
+
+    /// Parse a scene from TOML text.
+    pub fn from_toml(text: &str) -> Result<Self> {
+        let s: Scene = toml::from_str(text)
+            .map_err(|e| RvdynError::Scene(format!("invalid scene TOML: {e}")))?;
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Serialise to TOML.
+    pub fn to_toml(&self) -> Result<String> {
+        toml::to_string(self)
+            .map_err(|e| RvdynError::Scene(format!("scene cannot be written as TOML: {e}")))
+    }
+
+    /// Check the scene as a whole; errors say which field is wrong and how to fix it.
+    pub fn validate(&self) -> Result<()> {
+        let err = |m: String| Err(RvdynError::Scene(m));
+        if self.discs.is_empty() || self.discs.len() > 2 {
+            return err(format!(
+                "a scene needs 1 or 2 discs, got {}",
+                self.discs.len()
+            ));
+        }
+        for (k, d) in self.discs.iter().enumerate() {
+            for (n, v) in [
+                ("phase", Some(d.phase)),
+                ("d_rp", d.d_rp),
+                ("d_rrp", d.d_rrp),
+                ("d_delta", d.d_delta),
+            ] {
+                if let Some(v) = v {
+                    if !v.is_finite() {
+                        return err(format!("discs[{k}].{n} must be finite, got {v}"));
+                    }
+                }
+            }
+            crate::geometry::CycloidGeometry::new(self.disc_params(k))?;
+        }
+        if self.cranks < 1 {
+            return err("cranks must be at least 1".into());
+        }
+        if let Some(s) = &self.stage1 {
+            s.validate()?;
+            if s.planets != self.cranks {
+                return err(format!(
+                    "stage1.planets = {} must equal cranks = {} (each planet sits on a crank)",
+                    s.planets, self.cranks
+                ));
+            }
+        }
+        let zp = self.cycloid.pins as usize;
+        if !self.pin_errors.position.is_empty() && self.pin_errors.position.len() != zp {
+            return err(format!(
+                "pin_errors.position must have one (dx, dy) per pin ({zp}), got {}",
+                self.pin_errors.position.len()
+            ));
+        }
+        if !self.pin_errors.radius.is_empty() && self.pin_errors.radius.len() != zp {
+            return err(format!(
+                "pin_errors.radius must have one value per pin ({zp}), got {}",
+                self.pin_errors.radius.len()
+            ));
+        }
+        if self
+            .pin_errors
+            .position
+            .iter()
+            .flatten()
+            .chain(&self.pin_errors.radius)
+            .any(|v| !v.is_finite())
+        {
+            return err("pin_errors must be finite".into());
+        }
+        if !(self.density.is_finite() && self.density > 0.0) {
+            return err(format!("density must be > 0 kg/m^3, got {}", self.density));
+        }
+        let i = &self.inertias;
+        for (n, mp) in [
+            ("sun", i.sun),
+            ("crank", i.crank),
+            ("disc", i.disc),
+            ("carrier", i.carrier),
+        ] {
+            if let Some(mp) = mp {
+                if !(mp.mass.is_finite()
+                    && mp.mass > 0.0
+                    && mp.inertia.is_finite()
+                    && mp.inertia > 0.0)
+                {
+                    return err(format!(
+                        "inertias.{n} needs mass > 0 kg and inertia > 0 kg m^2, got {mp:?}"
+                    ));
+                }
+            }
+        }
+        if !(i.load_inertia.is_finite() && i.load_inertia >= 0.0) {
+            return err(format!(
+                "inertias.load_inertia must be >= 0 kg m^2, got {}",
+                i.load_inertia
+            ));
+        }
+        if let Joints::Compliant {
+            eccentric_bearing,
+            crank_bearing,
+        } = self.joints
+        {
+            for (n, b) in [
+                ("eccentric_bearing", eccentric_bearing),
+                ("crank_bearing", crank_bearing),
+            ] {
+                if !(b.stiffness.is_finite()
+                    && b.stiffness > 0.0
+                    && b.damping.is_finite()
+                    && b.damping >= 0.0
+                    && b.clearance.is_finite()
+                    && b.clearance >= 0.0)
+                {
+                    return err(format!(
+                        "joints.{n} needs stiffness > 0 N/m, damping >= 0 N s/m, clearance >= 0 m; got {b:?}"
+                    ));
+                }
+            }
+        }
+        self.contact.pin.law(self.cycloid.face_width)?;
+        if let Some(s) = &self.stage1 {
+            self.contact.mesh.law(s.face_width)?;
+        }
+        match self.drive {
+            Drive::Speed {
+                speed,
+                start,
+                ramp_time,
+            } => {
+                if !speed.is_finite() {
+                    return err(format!("drive.speed must be finite rad/s, got {speed}"));
+                }
+                if start == StartKind::Ramp && !(ramp_time.is_finite() && ramp_time > 0.0) {
+                    return err(format!(
+                        "drive.ramp_time must be > 0 s for a ramp start, got {ramp_time}"
+                    ));
+                }
+            }
+            Drive::Torque { torque, ramp_time } => {
+                if !torque.is_finite() || !(ramp_time.is_finite() && ramp_time >= 0.0) {
+                    return err(format!(
+                        "drive.torque must be finite and ramp_time >= 0, got {torque}, {ramp_time}"
+                    ));
+                }
+                if self.initial == Initial::Steady {
+                    return err("initial = \"steady\" needs a speed drive (the steady speed is undefined for a torque drive)".into());
+                }
+            }
+        }
+        match &self.load {
+            Load::Idle => {}
+            Load::Constant { torque } => {
+                if !torque.is_finite() {
+                    return err(format!("load.torque must be finite N m, got {torque}"));
+                }
+            }
+            Load::Step {
+                before,
+                after,
+                time,
+            } => {
+                if !(before.is_finite() && after.is_finite() && time.is_finite()) {
+                    return err("load step values must be finite".into());
+                }
+            }
+            Load::Table { points } => {
+                if points.is_empty() {
+                    return err("load.points needs at least one (t, torque) pair".into());
+                }
+                if points.iter().flatten().any(|v| !v.is_finite()) {
+                    return err("load.points must be finite".into());
+                }
+                if points.windows(2).any(|w| w[1][0] <= w[0][0]) {
+                    return err("load.points times must increase strictly".into());
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Geometry parameters of disc `k` (scene values with the disc's own modifications).
+    pub fn disc_params(&self, k: usize) -> CycloidParams {
+        let mut p = self.cycloid;
+        if let Some(d) = self.discs.get(k) {
+            p.d_rp = d.d_rp.unwrap_or(p.d_rp);
+            p.d_rrp = d.d_rrp.unwrap_or(p.d_rrp);
+            p.d_delta = d.d_delta.unwrap_or(p.d_delta);
+        }
+        p
+    }
+
+    /// Transmission ratio input speed / output speed of this scene (57 for the paper; `-zc`
+    /// when there is no first stage and the cranks are the input: the output turns backwards).
+    pub fn ratio(&self) -> f64 {
+        let zp = f64::from(self.cycloid.pins);
+        match &self.stage1 {
+            Some(s) => 1.0 + f64::from(s.z_planet) / f64::from(s.z_sun) * zp,
+            None => -(zp - 1.0),
+        }
+    }
+}
+
+/// The paper's first stage: 18/42 teeth, 3 planets, module 3 mm, 20 deg, face 30 mm.
+fn paper_stage1() -> Result<InvoluteStage> {
+    InvoluteStage::new(18, 42, 3, 3e-3, 20f64.to_radians(), 0.030)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_scene_is_valid_and_round_trips() {
+        for load in ["idle", "paper", "rated"] {
+            let s = Scene::paper(load).unwrap();
+            s.validate().unwrap();
+            assert_eq!(Scene::from_json(&s.to_json().unwrap()).unwrap(), s);
+            assert_eq!(Scene::from_toml(&s.to_toml().unwrap()).unwrap(), s);
+        }
+        assert!((Scene::paper("idle").unwrap().ratio() - 57.0).abs() < 1e-12);
+        match Scene::paper("rated").unwrap().load {
+            Load::Constant { torque } => assert!((torque - 43_923.0).abs() < 5.0, "{torque}"),
+            _ => panic!(),
+        }
+    }
+
+    #[test]
+    fn bad_scenes_say_what_is_wrong() {
+        assert!(
+            Scene::paper("heavy")
+                .unwrap_err()
+                .to_string()
+                .contains("unknown load case")
+        );
+        let mut s = Scene::paper("idle").unwrap();
+        s.discs.clear();
+        assert!(
+            s.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("1 or 2 discs")
+        );
+        let mut s = Scene::paper("idle").unwrap();
+        s.pin_errors.radius = vec![0.0; 5];
+        assert!(
+            s.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("one value per pin")
+        );
+        let mut s = Scene::paper("idle").unwrap();
+        s.load = Load::Constant { torque: f64::NAN };
+        assert!(s.validate().is_err());
+        assert!(Scene::from_json("{\"name\": 3}").is_err());
+        let text = Scene::paper("idle")
+            .unwrap()
+            .to_json()
+            .unwrap()
+            .replace("\"cranks\"", "\"crankz\"");
+        assert!(
+            Scene::from_json(&text)
+                .unwrap_err()
+                .to_string()
+                .contains("crankz")
+        );
+    }
+
+    #[test]
+    fn load_table_interpolates() {
+        let l = Load::Table {
+            points: vec![[0.0, 0.0], [1.0, 10.0], [2.0, 10.0]],
+        };
+        assert_eq!(l.torque(-1.0), 0.0);
+        assert!((l.torque(0.25) - 2.5).abs() < 1e-12);
+        assert_eq!(l.torque(5.0), 10.0);
+    }
+}

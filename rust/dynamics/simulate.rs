@@ -1,0 +1,220 @@
+//! The simulation driver: integrate a scene to `t_end`, recording at fixed sample times.
+
+use crate::dynamics::record::{Channel, Recorder, Recording};
+use crate::dynamics::rigid::RigidModel;
+use crate::dynamics::scene::Scene;
+use crate::dynamics::system::RigidSystem;
+use crate::error::{Result, RvdynError};
+use crate::solve::dopri5::Dopri5;
+use crate::solve::generalized_alpha::GeneralizedAlpha;
+use crate::solve::rk4::Rk4;
+use crate::solve::{Method, State};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+/// Options of one run (SI).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimOptions {
+    /// End time [s].
+    pub t_end: f64,
+    pub method: Method,
+    /// Step [s] of the fixed-step methods; initial step of the adaptive one. `None` = default.
+    pub dt: Option<f64>,
+    /// Relative tolerance (adaptive method, velocities).
+    pub rtol: f64,
+    /// Absolute displacement tolerance [m] (adaptive method).
+    pub atol: f64,
+    /// Spectral radius at infinity of generalized-alpha.
+    pub rho_inf: f64,
+    /// Sample interval [s]; `None` = the default (1e-4 s, coarsened to fit `max_samples`).
+    pub record_interval: Option<f64>,
+    /// Largest number of samples kept (memory bound: the interval is coarsened to fit).
+    pub max_samples: usize,
+    pub channels: Vec<Channel>,
+}
+
+impl SimOptions {
+    /// Defaults for a method (see BENCHMARKS.md for how they were chosen).
+    pub fn new(t_end: f64, method: Method) -> Self {
+        Self {
+            t_end,
+            method,
+            dt: None,
+            rtol: 1e-6,
+            atol: 1e-9,
+            rho_inf: 0.8,
+            record_interval: None,
+            max_samples: 50_000,
+            channels: Channel::defaults(),
+        }
+    }
+
+    /// The step used by a fixed-step method [s].
+    pub fn default_dt(method: Method) -> f64 {
+        match method {
+            Method::Rk4 => 1e-5,
+            Method::Dopri5 => 1e-6,
+            Method::GeneralizedAlpha => 2e-5,
+        }
+    }
+
+    fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Parameter(m));
+        if !(self.t_end.is_finite() && self.t_end > 0.0) {
+            return bad(format!(
+                "t_end must be a finite time > 0 s, got {}",
+                self.t_end
+            ));
+        }
+        if let Some(dt) = self.dt {
+            if !(dt.is_finite() && dt > 0.0 && dt <= self.t_end) {
+                return bad(format!("dt must be > 0 s and <= t_end, got {dt}"));
+            }
+        }
+        if !(self.rtol.is_finite() && self.rtol >= 0.0) {
+            return bad(format!("rtol must be >= 0, got {}", self.rtol));
+        }
+        if !(self.atol.is_finite() && self.atol > 0.0) {
+            return bad(format!("atol must be > 0 m, got {}", self.atol));
+        }
+        if let Some(r) = self.record_interval {
+            if !(r.is_finite() && r > 0.0) {
+                return bad(format!("record_interval must be > 0 s, got {r}"));
+            }
+        }
+        if self.max_samples < 2 {
+            return bad("max_samples must be at least 2".into());
+        }
+        Ok(())
+    }
+
+    /// The sample interval actually used [s].
+    pub fn sample_interval(&self) -> f64 {
+        let wanted = self.record_interval.unwrap_or(1e-4);
+        wanted.max(self.t_end / (self.max_samples - 1) as f64)
+    }
+}
+
+/// Shared with the caller while a run goes on: a stop request and the simulated time reached.
+#[derive(Debug, Default)]
+pub struct RunControl {
+    stop: AtomicBool,
+    time_bits: AtomicU64,
+}
+
+impl RunControl {
+    /// Ask the run to stop at its next step (it returns `RvdynError::Interrupted`).
+    pub fn request_stop(&self) {
+        self.stop.store(true, Ordering::Relaxed);
+    }
+    /// Simulated time reached so far [s].
+    pub fn time(&self) -> f64 {
+        f64::from_bits(self.time_bits.load(Ordering::Relaxed))
+    }
+    fn set_time(&self, t: f64) {
+        self.time_bits.store(t.to_bits(), Ordering::Relaxed);
+    }
+    fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
+}
+
+/// Simulate `scene` to `options.t_end` and return the recorded channels.
+///
+/// Errors: `Scene`/`Parameter` for bad input, `Simulation` when the run goes unstable (with
+/// what happened, when, and what would help), `Interrupted` when `control` asked to stop.
+pub fn simulate(scene: &Scene, options: &SimOptions, control: &RunControl) -> Result<Recording> {
+    options.validate()?;
+    let model = RigidModel::new(scene)?;
+    run(&model, options, control)
+}
+
+/// Integrate a built model.
+pub fn run(model: &RigidModel, opt: &SimOptions, control: &RunControl) -> Result<Recording> {
+    let sys = RigidSystem::new(model);
+    let (x0, v0) = model.initial_state();
+    let q0: Vec<f64> = model.free.iter().map(|&i| x0[i]).collect();
+    let v0f: Vec<f64> = model.free.iter().map(|&i| v0[i]).collect();
+    let mut st = State::new(&sys, 0.0, q0, v0f)?;
+    let interval = opt.sample_interval();
+    let n_samples = (opt.t_end / interval + 1e-9).floor() as usize + 1;
+    let mut rec = Recorder::new(model, &opt.channels, n_samples);
+    let track_work = opt.channels.contains(&Channel::Energy);
+    let mut next_sample = 0usize;
+    let record = |rec: &mut Recorder, s: &State| -> Result<()> {
+        let (x, v, acc) = sys.full(s.t, &s.q, &s.v);
+        rec.sample(model, s.t, &x, &v, acc, s.work)
+    };
+    let dt = opt.dt.unwrap_or_else(|| SimOptions::default_dt(opt.method));
+    let mut rk4 = Rk4::default();
+    let mut dopri = Dopri5::new(opt.rtol, opt.atol, dt, interval.max(dt));
+    let mut galpha = GeneralizedAlpha::new(opt.rho_inf, opt.atol.min(1e-9), track_work)?;
+    let n_fixed = (opt.t_end / dt).ceil().max(1.0) as u64;
+    let h_fixed = opt.t_end / n_fixed as f64;
+    let mut steps: u64 = 0;
+    while next_sample < n_samples && next_sample as f64 * interval <= st.t + 1e-12 {
+        record(&mut rec, &st)?;
+        next_sample += 1;
+    }
+    while st.t < opt.t_end * (1.0 - 1e-14) {
+        if control.stopped() {
+            return Err(RvdynError::Interrupted);
+        }
+        let prev = st.clone();
+        match opt.method {
+            Method::Rk4 => rk4.step(&sys, &mut st, h_fixed)?,
+            Method::GeneralizedAlpha => galpha.step(&sys, &mut st, h_fixed)?,
+            Method::Dopri5 => dopri.step(&sys, &mut st, opt.t_end)?,
+        }
+        steps += 1;
+        if matches!(opt.method, Method::Rk4 | Method::GeneralizedAlpha) && steps == n_fixed {
+            st.t = opt.t_end;
+        }
+        if !st.q.iter().chain(&st.v).all(|v| v.is_finite()) {
+            return Err(RvdynError::Simulation(format!(
+                "the state became non-finite at t = {:.6e} s; reduce the step or use the \
+                 implicit integrator",
+                st.t
+            )));
+        }
+        while next_sample < n_samples {
+            let ts = next_sample as f64 * interval;
+            if ts > st.t + 1e-12 {
+                break;
+            }
+            let s = prev.interpolate(&st, ts);
+            record(&mut rec, &s)?;
+            next_sample += 1;
+        }
+        control.set_time(st.t);
+    }
+    let mut out = rec.finish();
+    out.stats.insert("steps", steps as f64);
+    match opt.method {
+        Method::Rk4 => {
+            out.stats.insert("evaluations", 4.0 * steps as f64);
+        }
+        Method::Dopri5 => {
+            out.stats.insert("rejected", dopri.rejected as f64);
+            out.stats.insert(
+                "evaluations",
+                6.0 * (dopri.accepted + dopri.rejected) as f64,
+            );
+        }
+        Method::GeneralizedAlpha => {
+            out.stats.insert("evaluations", galpha.evaluations as f64);
+            out.stats.insert("jacobians", galpha.jacobians as f64);
+            out.stats
+                .insert("newton_iterations", galpha.newton_iterations as f64);
+            out.stats.insert("splits", galpha.splits as f64);
+        }
+    }
+    out.stats.insert(
+        "dt",
+        if opt.method == Method::Dopri5 {
+            f64::NAN
+        } else {
+            h_fixed
+        },
+    );
+    Ok(out)
+}

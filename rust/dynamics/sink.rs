@@ -1,0 +1,30 @@
+//! Where a force evaluation reports each contact: nowhere on the hot path, into a sample when
+//! recording. Generic, so the hot path pays nothing for it.
+
+/// Receives every contact of one force evaluation.
+pub trait ContactSink {
+    /// Whether the elastic energy of the contacts is wanted (costs a power per contact).
+    fn wants_energy(&self) -> bool {
+        false
+    }
+    /// Pin `j` on disc `k`: normal force [N], penetration [m], moment of the pin force about
+    /// the disc centre [N m], contact point and unit outward profile normal (fixed frame).
+    #[allow(clippy::too_many_arguments)]
+    fn pin(
+        &mut self,
+        _k: usize,
+        _j: usize,
+        _force: f64,
+        _pen: f64,
+        _moment: f64,
+        _point: [f64; 2],
+        _normal: [f64; 2],
+    ) {
+    }
+    /// Mesh `i`: force along the line of action [N] (negative on the coast flank), deflection [m].
+    fn mesh(&mut self, _i: usize, _force: f64, _deflection: f64) {}
+}
+
+/// The sink of the hot path: ignores everything.
+pub struct NoSink;
+impl ContactSink for NoSink {}

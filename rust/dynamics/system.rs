@@ -1,0 +1,67 @@
+//! The rigid-joint model seen by the integrators: free coordinates only.
+
+use crate::dynamics::rigid::{CARRIER, RigidModel};
+use crate::dynamics::sink::NoSink;
+use crate::error::Result;
+use crate::solve::MechanicalSystem;
+
+/// Adapter from [`RigidModel`] (full coordinates) to a [`MechanicalSystem`] in the free ones.
+pub struct RigidSystem<'a> {
+    pub model: &'a RigidModel,
+    scale: Vec<f64>,
+}
+
+impl<'a> RigidSystem<'a> {
+    pub fn new(model: &'a RigidModel) -> Self {
+        let scale = model.free.iter().map(|&i| model.length_scale[i]).collect();
+        Self { model, scale }
+    }
+
+    /// Full coordinates from free ones at time `t` (prescribed ones from the drive); returns
+    /// the prescribed acceleration.
+    #[inline]
+    pub fn full(&self, t: f64, q: &[f64], v: &[f64]) -> ([f64; 3], [f64; 3], f64) {
+        let mut x = [0.0; 3];
+        let mut xv = [0.0; 3];
+        for (k, &i) in self.model.free.iter().enumerate() {
+            x[i] = q[k];
+            xv[i] = v[k];
+        }
+        let acc = self.model.apply_drive(t, &mut x, &mut xv);
+        (x, xv, acc)
+    }
+}
+
+impl MechanicalSystem for RigidSystem<'_> {
+    fn dof(&self) -> usize {
+        self.model.free.len()
+    }
+
+    fn eval(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &mut [f64],
+        power: &mut [f64; 3],
+    ) -> Result<()> {
+        let m = self.model;
+        let (x, xv, _) = self.full(t, q, v);
+        let f = m.forces(t, &x, &xv, &mut NoSink)?;
+        for (k, &i) in m.free.iter().enumerate() {
+            a[k] = f.q[i] / m.mass[i];
+        }
+        power[0] = match (m.prescribed, m.drive.torque(t)) {
+            (Some(p), _) => -f.q[p] * xv[p],
+            (None, Some(tq)) => tq * xv[m.input],
+            (None, None) => 0.0,
+        };
+        power[1] = m.load.torque(t) * xv[CARRIER];
+        power[2] = f.dissipation;
+        Ok(())
+    }
+
+    fn length_scale(&self) -> &[f64] {
+        &self.scale
+    }
+}

@@ -1,0 +1,212 @@
+//! Adaptive Dormand-Prince 5(4) with an error norm on displacements.
+//!
+//! The error of coordinate `i` is weighed by its lever `L_i` (m per rad): a position error
+//! counts as `|e_q| L_i` against `atol` [m]; a velocity error as `|e_v| L_i tau` against
+//! `atol + rtol |v_i| L_i tau` with `tau = 1 ms`, so that `atol` bounds both the displacement
+//! error and the displacement a velocity error makes within a millisecond. No relative
+//! tolerance on positions: absolute angles grow without bound and say nothing about accuracy.
+
+use crate::error::{Result, RvdynError};
+use crate::solve::system::{MechanicalSystem, State};
+
+/// Time over which a velocity error is turned into a displacement error [s].
+pub const VELOCITY_ERROR_TIME: f64 = 1e-3;
+
+const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
+const A: [[f64; 6]; 7] = [
+    [0.0; 6],
+    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
+];
+/// Fifth-order weights (= last row of A: first same as last).
+const B: [f64; 7] = [
+    35.0 / 384.0,
+    0.0,
+    500.0 / 1113.0,
+    125.0 / 192.0,
+    -2187.0 / 6784.0,
+    11.0 / 84.0,
+    0.0,
+];
+/// Difference between the fifth- and fourth-order weights.
+const E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
+
+/// Step-size controller settings and statistics of the adaptive method.
+#[derive(Debug)]
+pub struct Dopri5 {
+    pub rtol: f64,
+    /// Displacement tolerance [m].
+    pub atol: f64,
+    /// Current step proposal [s].
+    pub h: f64,
+    /// Smallest step allowed before the run is declared failed [s].
+    pub h_min: f64,
+    /// Largest step [s].
+    pub h_max: f64,
+    pub accepted: u64,
+    pub rejected: u64,
+    kq: [Vec<f64>; 7],
+    kv: [Vec<f64>; 7],
+    kw: [[f64; 3]; 7],
+    q: Vec<f64>,
+    v: Vec<f64>,
+    err_prev: f64,
+}
+
+impl Dopri5 {
+    /// A controller starting with step `h0` [s].
+    pub fn new(rtol: f64, atol: f64, h0: f64, h_max: f64) -> Self {
+        Self {
+            rtol,
+            atol,
+            h: h0,
+            h_min: 1e-13,
+            h_max,
+            accepted: 0,
+            rejected: 0,
+            kq: Default::default(),
+            kv: Default::default(),
+            kw: [[0.0; 3]; 7],
+            q: Vec::new(),
+            v: Vec::new(),
+            err_prev: 1e-4,
+        }
+    }
+
+    /// Take one accepted step, not past `t_stop`; rejected tries are retried with a smaller
+    /// step. Fails with `SimulationError` when the step collapses below `h_min`.
+    pub fn step<S: MechanicalSystem>(
+        &mut self,
+        sys: &S,
+        st: &mut State,
+        t_stop: f64,
+    ) -> Result<()> {
+        let n = st.q.len();
+        for k in 0..7 {
+            self.kq[k].resize(n, 0.0);
+            self.kv[k].resize(n, 0.0);
+        }
+        self.q.resize(n, 0.0);
+        self.v.resize(n, 0.0);
+        let scale = sys.length_scale().to_vec();
+        loop {
+            let h = self.h.min(t_stop - st.t).min(self.h_max);
+            if h < self.h_min {
+                return Err(RvdynError::Simulation(format!(
+                    "adaptive step size collapsed to {h:.3e} s at t = {:.6e} s: the contact is \
+                     too stiff or the state too violent for the explicit Dormand-Prince method; \
+                     use integrator=\"generalized-alpha\" or loosen atol/rtol",
+                    st.t
+                )));
+            }
+            self.kq[0].copy_from_slice(&st.v);
+            self.kv[0].copy_from_slice(&st.a);
+            self.kw[0] = st.power;
+            let mut failed = None;
+            for s in 1..7 {
+                for i in 0..n {
+                    let mut dq = 0.0;
+                    let mut dv = 0.0;
+                    for (r, a) in A[s].iter().enumerate().take(s) {
+                        dq += a * self.kq[r][i];
+                        dv += a * self.kv[r][i];
+                    }
+                    self.q[i] = st.q[i] + h * dq;
+                    self.v[i] = st.v[i] + h * dv;
+                }
+                self.kq[s].copy_from_slice(&self.v);
+                let (kv, kw) = (&mut self.kv[s], &mut self.kw[s]);
+                if let Err(e) = sys.eval(st.t + C[s] * h, &self.q, &self.v, kv, kw) {
+                    failed = Some(e);
+                    break;
+                }
+            }
+            // A stage that went unphysical is a too-large step, not yet a failed run.
+            let err = match failed {
+                Some(e) => {
+                    if h <= self.h_min * 16.0 {
+                        return Err(e);
+                    }
+                    f64::INFINITY
+                }
+                None => self.error_norm(st, h, &scale),
+            };
+            if err <= 1.0 {
+                // Stage 7 is the new state (FSAL).
+                st.q.copy_from_slice(&self.q);
+                st.v.copy_from_slice(&self.v);
+                st.a.copy_from_slice(&self.kv[6]);
+                st.power = self.kw[6];
+                for j in 0..3 {
+                    st.work[j] += h * (0..7).map(|s| B[s] * self.kw[s][j]).sum::<f64>();
+                }
+                st.t += h;
+                self.accepted += 1;
+                // PI controller (Hairer's DOPRI5 constants).
+                let fac = 0.9 * err.max(1e-10).powf(-0.7 / 5.0) * self.err_prev.powf(0.4 / 5.0);
+                self.h = h * fac.clamp(0.2, 5.0);
+                self.err_prev = err.max(1e-4);
+                return Ok(());
+            }
+            self.rejected += 1;
+            let fac = if err.is_finite() {
+                0.9 * err.powf(-0.2)
+            } else {
+                0.1
+            };
+            self.h = h * fac.clamp(0.1, 0.5);
+        }
+    }
+
+    fn error_norm(&self, st: &State, h: f64, scale: &[f64]) -> f64 {
+        let n = st.q.len();
+        let mut sum = 0.0;
+        for i in 0..n {
+            let (mut eq, mut ev) = (0.0, 0.0);
+            for s in 0..7 {
+                eq += E[s] * self.kq[s][i];
+                ev += E[s] * self.kv[s][i];
+            }
+            let l = scale[i];
+            let wq = (h * eq * l) / self.atol;
+            let vmax = st.v[i].abs().max(self.v[i].abs());
+            let wv = (h * ev * l * VELOCITY_ERROR_TIME)
+                / (self.atol + self.rtol * vmax * l * VELOCITY_ERROR_TIME);
+            sum += wq * wq + wv * wv;
+        }
+        (sum / (2 * n) as f64).sqrt()
+    }
+}

@@ -1,0 +1,79 @@
+//! What an integrator sees: a second-order mechanical system `q'' = f(t, q, v)` with three
+//! power flows to integrate alongside (input, output, dissipated).
+
+use crate::error::Result;
+
+/// A second-order system in its free coordinates.
+pub trait MechanicalSystem {
+    /// Number of free coordinates.
+    fn dof(&self) -> usize;
+    /// Accelerations `a = M^-1 Q(t, q, v)` and the power flows `[input, output, dissipated]` [W].
+    fn eval(&self, t: f64, q: &[f64], v: &[f64], a: &mut [f64], power: &mut [f64; 3])
+    -> Result<()>;
+    /// Length per unit of each coordinate [m] (a lever arm for an angle): error control and
+    /// Newton convergence act on displacements, not on angles that grow to tens of radians.
+    fn length_scale(&self) -> &[f64];
+}
+
+/// The integrated state: coordinates, velocities, accelerations and energy flows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
+    pub t: f64,
+    pub q: Vec<f64>,
+    pub v: Vec<f64>,
+    /// Acceleration at `t` (for dense output and the generalized-alpha recursion).
+    pub a: Vec<f64>,
+    /// Power flows at `t` `[input, output, dissipated]` [W].
+    pub power: [f64; 3],
+    /// Integrated `[input work, output work, dissipated energy]` [J].
+    pub work: [f64; 3],
+}
+
+impl State {
+    /// A state at `t` with accelerations evaluated from the system.
+    pub fn new<S: MechanicalSystem>(sys: &S, t: f64, q: Vec<f64>, v: Vec<f64>) -> Result<Self> {
+        let mut a = vec![0.0; q.len()];
+        let mut p = [0.0; 3];
+        sys.eval(t, &q, &v, &mut a, &mut p)?;
+        Ok(Self {
+            t,
+            q,
+            v,
+            a,
+            power: p,
+            work: [0.0; 3],
+        })
+    }
+
+    /// Cubic Hermite interpolation between `self` and `next` at time `t`: positions from
+    /// (q, v), velocities from (v, a); work linearly.
+    pub fn interpolate(&self, next: &State, t: f64) -> State {
+        let h = next.t - self.t;
+        let s = if h > 0.0 {
+            ((t - self.t) / h).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let (h00, h10, h01, h11) = (
+            (1.0 + 2.0 * s) * (1.0 - s) * (1.0 - s),
+            s * (1.0 - s) * (1.0 - s),
+            s * s * (3.0 - 2.0 * s),
+            s * s * (s - 1.0),
+        );
+        let herm = |y0: &[f64], d0: &[f64], y1: &[f64], d1: &[f64]| -> Vec<f64> {
+            (0..y0.len())
+                .map(|i| h00 * y0[i] + h10 * h * d0[i] + h01 * y1[i] + h11 * h * d1[i])
+                .collect()
+        };
+        State {
+            t,
+            q: herm(&self.q, &self.v, &next.q, &next.v),
+            v: herm(&self.v, &self.a, &next.v, &next.a),
+            a: (0..self.a.len())
+                .map(|i| (1.0 - s) * self.a[i] + s * next.a[i])
+                .collect(),
+            power: std::array::from_fn(|i| (1.0 - s) * self.power[i] + s * next.power[i]),
+            work: std::array::from_fn(|i| (1.0 - s) * self.work[i] + s * next.work[i]),
+        }
+    }
+}
