@@ -1,0 +1,226 @@
+"""Results of a dynamic run: numpy arrays (first axis = time), summaries, plots, ``.npz`` files."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any, Iterable
+
+import numpy as np
+
+from .errors import ParameterError
+
+__all__ = ["Result"]
+
+# Attribute -> meaning, unit and per-sample shape (for the docs and __repr__).
+CHANNELS: dict[str, str] = {
+    "t": "sample time [s], (n,)",
+    "sun_angle": "sun (input) angle [rad], (n,)",
+    "sun_speed": "sun (input) speed [rad/s], (n,)",
+    "carrier_angle": "carrier (output) angle [rad], (n,)",
+    "carrier_speed": "carrier (output) speed [rad/s], (n,)",
+    "crank_angle": "absolute rotation angle of each crankshaft [rad], (n, cranks)",
+    "crank_speed": "absolute speed of each crankshaft [rad/s], (n, cranks)",
+    "disc_center": "disc centres about the reducer axis [m], (n, discs, 2)",
+    "disc_angle": "disc rotation angles [rad], (n, discs)",
+    "pin_force": "normal force of pin j on disc k [N], (n, discs, pins); j = paper pin j+1",
+    "pin_penetration": "penetration of pin j into disc k [m], (n, discs, pins)",
+    "pin_moment": "moment of pin j's force about disc k's centre [N m] (z component; about "
+    "the ring centre it is zp/zc times larger), (n, discs, pins)",
+    "loaded_pins": "number of pins in contact per disc, (n, discs)",
+    "pin_point": "contact point on the profile, fixed frame [m], (n, discs, pins, 2)",
+    "pin_normal": "unit outward profile normal at the contact, (n, discs, pins, 2)",
+    "mesh_force": "sun/planet mesh force along the line of action [N], (n, planets)",
+    "mesh_deflection": "mesh deflection along the line of action [m], (n, planets)",
+    "input_torque": "torque the drive applies to the input [N m], (n,)",
+    "kinetic_energy": "kinetic energy of the free bodies [J], (n,)",
+    "potential_energy": "elastic energy in the contacts [J], (n,)",
+    "input_work": "work done by the drive [J], (n,)",
+    "output_work": "work done against the load [J], (n,)",
+    "dissipated_energy": "energy dissipated by contact damping [J], (n,)",
+    "energy_residual": "E_kin + E_el - E0 - W_in + W_out + D [J] (0 for an exact integration), (n,)",
+}
+
+
+class Result:
+    """Recorded channels of one run. Each channel in :data:`CHANNELS` that was recorded is an
+    attribute holding a numpy array whose first axis is time; ``stats`` holds the integrator
+    statistics (steps, evaluations, wall_time [s], ...); ``scene`` the scene as a dict."""
+
+    def __init__(self, arrays: dict[str, np.ndarray], stats: dict[str, float], scene: dict[str, Any] | None = None,
+                 options: dict[str, Any] | None = None):
+        self._arrays = dict(arrays)
+        self.stats = dict(stats)
+        self.scene = scene or {}
+        self.options = options or {}
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        arrays = self.__dict__.get("_arrays", {})
+        if name in arrays:
+            return arrays[name]
+        if name in CHANNELS:
+            raise AttributeError(f"channel {name!r} was not recorded: ask for it with channels=[...]")
+        raise AttributeError(name)
+
+    @property
+    def channels(self) -> list[str]:
+        """Names of the recorded arrays."""
+        return sorted(self._arrays)
+
+    def __repr__(self) -> str:
+        n = len(self._arrays.get("t", []))
+        return f"Result({n} samples, t_end={float(self._arrays['t'][-1]) if n else 0:.4g} s, channels={self.channels})"
+
+    # ----------------------------------------------------------------- analysis
+    def _steady_start(self, t_start: float | None) -> float:
+        t = self.t
+        return float(t[-1] * 0.2 if t_start is None else t_start)
+
+    def steady_window(self, t_start: float | None = None) -> tuple[float, float]:
+        """The largest window ``[t0, t_end]`` with ``t0 >= t_start`` spanning whole crank
+        revolutions relative to the carrier (whole mesh cycles: every pin is back in its
+        place). ``t_start`` defaults to 20 % of the run. Times in s."""
+        t = self.t
+        rel = self.crank_angle[:, 0] - self.carrier_angle
+        t0 = self._steady_start(t_start)
+        if not (t[0] <= t0 < t[-1]):
+            raise ParameterError(f"t_start = {t0} s must lie inside the run [0, {t[-1]}) s")
+        i0 = int(np.searchsorted(t, t0))
+        span = abs(rel[-1] - rel[i0])
+        turns = math.floor(span / (2 * math.pi))
+        if turns < 1:
+            raise ParameterError(
+                f"the window from {t0:.3g} s holds less than one crank revolution; run longer or start earlier"
+            )
+        # Remaining crank rotation until the end: decreases to 0 in a running reducer.
+        remaining = np.abs(rel[i0:] - rel[-1])
+        t_window = float(np.interp(turns * 2 * math.pi, remaining[::-1], t[i0:][::-1]))
+        return t_window, float(t[-1])
+
+    def mean_output_speed(self, t_start: float | None = None) -> float:
+        """Mean carrier speed [rad/s] over whole crank revolutions after ``t_start`` [s]:
+        (angle change) / (time), exact for the recorded angles, no averaging of samples."""
+        t0, t1 = self.steady_window(t_start)
+        a0 = float(np.interp(t0, self.t, self.carrier_angle))
+        return (float(self.carrier_angle[-1]) - a0) / (t1 - t0)
+
+    def disc_path_radius(self, t_start: float | None = None) -> np.ndarray:
+        """(min, mean, max) distance of each disc centre from the reducer axis [m] after
+        ``t_start``, shape (discs, 3)."""
+        i0 = int(np.searchsorted(self.t, self._steady_start(t_start)))
+        r = np.linalg.norm(self.disc_center[i0:], axis=-1)
+        return np.stack([r.min(axis=0), r.mean(axis=0), r.max(axis=0)], axis=-1)
+
+    def loaded_pin_stats(self, t_start: float | None = None) -> np.ndarray:
+        """(min, mean, max) number of loaded pins per disc after ``t_start``, shape (discs, 3)."""
+        i0 = int(np.searchsorted(self.t, self._steady_start(t_start)))
+        n = self.loaded_pins[i0:]
+        return np.stack([n.min(axis=0), n.mean(axis=0), n.max(axis=0)], axis=-1)
+
+    def largest_moment_pin(self, time: float, disc: int = 0) -> int:
+        """The paper's number (1-based) of the pin with the largest |moment| on ``disc`` at the
+        sample nearest ``time`` [s]."""
+        i = int(np.argmin(np.abs(self.t - time)))
+        return int(np.argmax(np.abs(self.pin_moment[i, disc]))) + 1
+
+    def energy_balance(self) -> dict[str, float]:
+        """Final input work, output work, dissipation, energy change and the residual [J],
+        plus the residual relative to the largest of them."""
+        w_in = float(self.input_work[-1])
+        w_out = float(self.output_work[-1])
+        diss = float(self.dissipated_energy[-1])
+        change = float(self.kinetic_energy[-1] + self.potential_energy[-1] - self.kinetic_energy[0] - self.potential_energy[0])
+        res = float(self.energy_residual[-1])
+        scale = max(abs(w_in), abs(w_out), abs(diss), abs(change), 1e-300)
+        return {"input_work": w_in, "output_work": w_out, "dissipated": diss, "energy_change": change,
+                "residual": res, "relative_residual": abs(res) / scale}
+
+    # -------------------------------------------------------------------- files
+    def save(self, path: str | Path) -> Path:
+        """Write all arrays, statistics, scene and options to a compressed ``.npz`` file."""
+        p = Path(path)
+        meta = json.dumps({"stats": self.stats, "scene": self.scene, "options": self.options})
+        np.savez_compressed(p, __meta__=np.array(meta), **self._arrays)
+        return p if p.suffix == ".npz" else p.with_name(p.name + ".npz")
+
+    @classmethod
+    def load(cls, path: str | Path) -> "Result":
+        """Read a file written by :meth:`save`."""
+        with np.load(Path(path), allow_pickle=False) as f:
+            meta = json.loads(str(f["__meta__"]))
+            arrays = {k: f[k] for k in f.files if k != "__meta__"}
+        return cls(arrays, meta.get("stats", {}), meta.get("scene"), meta.get("options"))
+
+    # -------------------------------------------------------------------- plots
+    def plot_output_speed(self, ax: Any = None, theory: float | None = None) -> Any:
+        """Output (carrier) speed vs time in deg/s, as the paper's Figs. 5-6, with the
+        theoretical speed (input/ratio) if ``theory`` [rad/s] is given."""
+        ax = _axes(ax)
+        ax.plot(self.t, np.degrees(self.carrier_speed), lw=0.6, label="simulated")
+        if theory is not None:
+            ax.axhline(math.degrees(theory), color="k", ls="--", lw=0.8, label=f"theory {math.degrees(theory):.3f} deg/s")
+        ax.set(xlabel="time [s]", ylabel="output speed [deg/s]")
+        ax.legend(loc="best")
+        return ax
+
+    def plot_disc_center(self, disc: int = 0, axes: Any = None) -> Any:
+        """Disc centre x and y vs time [mm] and its path, as the paper's Fig. 7."""
+        import matplotlib.pyplot as plt
+
+        if axes is None:
+            _, axes = plt.subplots(1, 2, figsize=(11, 4))
+        c = self.disc_center[:, disc] * 1e3
+        axes[0].plot(self.t, c[:, 0], lw=0.6, label="x")
+        axes[0].plot(self.t, c[:, 1], lw=0.6, label="y")
+        axes[0].set(xlabel="time [s]", ylabel=f"disc {disc} centre [mm]")
+        axes[0].legend()
+        axes[1].plot(c[:, 0], c[:, 1], lw=0.6)
+        axes[1].set(xlabel="x [mm]", ylabel="y [mm]", aspect="equal", title="centre path")
+        return axes
+
+    def plot_pin_moments(self, pins: Iterable[int] = (22, 23, 24, 1, 2, 3, 4), disc: int = 0,
+                         window: tuple[float, float] | None = None, ax: Any = None) -> Any:
+        """Moment of each pin's force about the disc centre [N m] vs time, for the paper's pin
+        numbers ``pins`` (1-based), as the paper's Figs. 8-14, in ``window`` [s]."""
+        ax = _axes(ax)
+        t = self.t
+        sel = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
+        for p in pins:
+            ax.plot(t[sel], self.pin_moment[sel, disc, p - 1], lw=0.8, label=f"pin {p}")
+        ax.set(xlabel="time [s]", ylabel=f"moment about disc {disc} centre [N m]")
+        ax.legend(ncol=4, fontsize="small")
+        return ax
+
+    def plot_loaded_pins(self, ax: Any = None) -> Any:
+        """Number of loaded pins per disc vs time."""
+        ax = _axes(ax)
+        for k in range(self.loaded_pins.shape[1]):
+            ax.plot(self.t, self.loaded_pins[:, k], lw=0.8, drawstyle="steps-post", label=f"disc {k}")
+        ax.set(xlabel="time [s]", ylabel="loaded pins")
+        ax.legend()
+        return ax
+
+    def plot_input_torque(self, ax: Any = None) -> Any:
+        """Input torque [N m] vs time."""
+        ax = _axes(ax)
+        ax.plot(self.t, self.input_torque, lw=0.6)
+        ax.set(xlabel="time [s]", ylabel="input torque [N m]")
+        return ax
+
+    def plot_energy(self, ax: Any = None) -> Any:
+        """Energy flows [J] and the balance residual vs time."""
+        ax = _axes(ax)
+        for name in ("input_work", "output_work", "dissipated_energy", "kinetic_energy", "energy_residual"):
+            ax.plot(self.t, getattr(self, name), lw=0.8, label=name)
+        ax.set(xlabel="time [s]", ylabel="energy [J]")
+        ax.legend(fontsize="small")
+        return ax
+
+
+def _axes(ax: Any) -> Any:
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(figsize=(8, 4))[1]
