@@ -1,6 +1,9 @@
 //! Scenes, the equations of motion and the simulation driver.
 
+pub mod compliant;
 pub mod drive;
+pub mod model;
+pub mod pin_contact;
 pub mod record;
 pub mod rigid;
 pub mod scene;

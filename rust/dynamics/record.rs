@@ -1,6 +1,6 @@
 //! Recording of selected channels at sample times, into flat arrays (first axis = time).
 
-use crate::dynamics::rigid::{CARRIER, CRANK, RigidModel, SUN};
+use crate::dynamics::model::{Layout, ReducerModel};
 use crate::dynamics::sink::ContactSink;
 use crate::error::{Result, RvdynError};
 use std::collections::BTreeMap;
@@ -119,15 +119,14 @@ pub(crate) struct Recorder {
     rec: Recording,
     sink: SampleSink,
     nd: usize,
-    ncr: usize,
     initial_energy: Option<f64>,
 }
 
 impl Recorder {
-    pub fn new(model: &RigidModel, channels: &[Channel], capacity: usize) -> Self {
-        let nd = model.discs.len();
-        let zp = model.pins.len();
-        let nm = model.mesh.map_or(0, |m| m.count);
+    pub fn new(layout: Layout, channels: &[Channel], capacity: usize) -> Self {
+        let nd = layout.discs;
+        let zp = layout.pins;
+        let nm = layout.meshes;
         let has = |c| channels.contains(&c);
         let mut series: BTreeMap<&'static str, Series> = BTreeMap::new();
         let mut add = |name: &'static str, shape: Vec<usize>| {
@@ -145,8 +144,8 @@ impl Recorder {
             for n in ["sun_angle", "sun_speed", "carrier_angle", "carrier_speed"] {
                 add(n, vec![]);
             }
-            add("crank_angle", vec![model.cranks]);
-            add("crank_speed", vec![model.cranks]);
+            add("crank_angle", vec![layout.cranks]);
+            add("crank_speed", vec![layout.cranks]);
             add("disc_center", vec![nd, 2]);
             add("disc_angle", vec![nd]);
         }
@@ -199,7 +198,6 @@ impl Recorder {
             },
             sink,
             nd,
-            ncr: model.cranks,
             initial_energy: None,
         }
     }
@@ -210,57 +208,30 @@ impl Recorder {
         }
     }
 
-    /// Record the state `(x, v)` (full coordinates) at `t` with integrated `work`.
-    pub fn sample(
-        &mut self,
-        model: &RigidModel,
-        t: f64,
-        x: &[f64; 3],
-        v: &[f64; 3],
-        acc_in: f64,
-        work: [f64; 3],
-    ) -> Result<()> {
+    /// Record the free state `(q, v)` at `t` with integrated `work`.
+    pub fn sample<M: ReducerModel>(&mut self, model: &M, t: f64, q: &[f64], v: &[f64], work: [f64; 3]) -> Result<()> {
         let channels = self.channels.clone();
         let has = |c| channels.contains(&c);
-        let needs_forces = has(Channel::Pins)
-            || has(Channel::ContactPoints)
-            || has(Channel::Mesh)
-            || has(Channel::Energy);
-        let forces = if needs_forces {
-            Some(model.forces(t, x, v, &mut self.sink)?)
-        } else {
-            None
-        };
+        let obs = model.observe(t, q, v, &mut self.sink)?;
         self.push("t", &[t]);
         if has(Channel::Motion) {
-            self.push("sun_angle", &[x[SUN]]);
-            self.push("sun_speed", &[v[SUN]]);
-            self.push("carrier_angle", &[x[CARRIER]]);
-            self.push("carrier_speed", &[v[CARRIER]]);
-            let ca = vec![x[CRANK]; self.ncr];
-            let cs = vec![v[CRANK]; self.ncr];
-            self.push("crank_angle", &ca);
-            self.push("crank_speed", &cs);
+            self.push("sun_angle", &[obs.sun_angle]);
+            self.push("sun_speed", &[obs.sun_speed]);
+            self.push("carrier_angle", &[obs.carrier_angle]);
+            self.push("carrier_speed", &[obs.carrier_speed]);
+            self.push("crank_angle", &obs.crank_angle);
+            self.push("crank_speed", &obs.crank_speed);
             for k in 0..self.nd {
-                let (o, th) = model.disc_pose(k, x);
-                self.push("disc_center", &o);
-                self.push("disc_angle", &[th]);
+                self.push("disc_center", &obs.disc_center[k]);
             }
+            self.push("disc_angle", &obs.disc_angle);
         }
         if has(Channel::Pins) {
+            let zp = self.sink.zp;
             let loaded: Vec<f64> = (0..self.nd)
-                .map(|k| {
-                    self.sink.force[k * self.sink.zp..(k + 1) * self.sink.zp]
-                        .iter()
-                        .filter(|f| **f > 0.0)
-                        .count() as f64
-                })
+                .map(|k| self.sink.force[k * zp..(k + 1) * zp].iter().filter(|f| **f > 0.0).count() as f64)
                 .collect();
-            let (f, p, m) = (
-                self.sink.force.clone(),
-                self.sink.pen.clone(),
-                self.sink.moment.clone(),
-            );
+            let (f, p, m) = (self.sink.force.clone(), self.sink.pen.clone(), self.sink.moment.clone());
             self.push("pin_force", &f);
             self.push("pin_penetration", &p);
             self.push("pin_moment", &m);
@@ -271,33 +242,22 @@ impl Recorder {
             self.push("pin_point", &pt);
             self.push("pin_normal", &nm);
         }
-        if let Some(f) = forces {
-            if has(Channel::Mesh) {
-                let torque = match (model.prescribed, model.drive.torque(t)) {
-                    (Some(p), _) => model.mass[p] * acc_in - f.q[p],
-                    (None, Some(tq)) => tq,
-                    (None, None) => 0.0,
-                };
-                let (mf, md) = (
-                    self.sink.mesh_force.clone(),
-                    self.sink.mesh_deflection.clone(),
-                );
-                self.push("mesh_force", &mf);
-                self.push("mesh_deflection", &md);
-                self.push("input_torque", &[torque]);
-            }
-            if has(Channel::Energy) {
-                let ke = model.kinetic_energy(v);
-                let e = ke + f.potential;
-                let e0 = *self.initial_energy.get_or_insert(e);
-                let residual = e - e0 - work[0] + work[1] + work[2];
-                self.push("kinetic_energy", &[ke]);
-                self.push("potential_energy", &[f.potential]);
-                self.push("input_work", &[work[0]]);
-                self.push("output_work", &[work[1]]);
-                self.push("dissipated_energy", &[work[2]]);
-                self.push("energy_residual", &[residual]);
-            }
+        if has(Channel::Mesh) {
+            let (mf, md) = (self.sink.mesh_force.clone(), self.sink.mesh_deflection.clone());
+            self.push("mesh_force", &mf);
+            self.push("mesh_deflection", &md);
+            self.push("input_torque", &[obs.input_torque]);
+        }
+        if has(Channel::Energy) {
+            let e = obs.kinetic_energy + obs.potential_energy;
+            let e0 = *self.initial_energy.get_or_insert(e);
+            let residual = e - e0 - work[0] + work[1] + work[2];
+            self.push("kinetic_energy", &[obs.kinetic_energy]);
+            self.push("potential_energy", &[obs.potential_energy]);
+            self.push("input_work", &[work[0]]);
+            self.push("output_work", &[work[1]]);
+            self.push("dissipated_energy", &[work[2]]);
+            self.push("energy_residual", &[residual]);
         }
         self.rec.samples += 1;
         Ok(())

@@ -14,6 +14,7 @@
 
 use crate::contact::ImpactLaw;
 use crate::dynamics::drive::DriveProfile;
+use crate::dynamics::pin_contact::{penetration_error, pin_contact};
 use crate::dynamics::scene::{Initial, Joints, Load, Scene};
 use crate::dynamics::sink::ContactSink;
 use crate::error::{Result, RvdynError};
@@ -278,58 +279,30 @@ impl RigidModel {
         let va = v[CRANK];
         for (k, d) in self.discs.iter().enumerate() {
             let (o, th) = self.disc_pose(k, x);
-            let (s, c) = th.sin_cos();
-            let rot_mod = d.geometry.params().d_delta;
-            let r_gen = d.geometry.generating_pin_radius();
             for (j, pin) in self.pins.iter().enumerate() {
-                // Pin centre in the disc frame.
-                let dp = [pin.centre[0] - o[0], pin.centre[1] - o[1]];
-                let local = d
-                    .geometry
-                    .remove_rotation_mod([c * dp[0] + s * dp[1], -s * dp[0] + c * dp[1]]);
-                let seed = pin.angle - th - rot_mod;
-                let foot = d.geometry.foot_with_fallback(local, seed).ok_or_else(|| {
-                    RvdynError::Convergence(format!(
-                        "exact gap of pin {} on disc {k} not found at t = {t:.6e} s: the disc is \
-                         far from its kinematic pose (the run has gone unstable; reduce the step)",
-                        j + 1
-                    ))
-                })?;
-                let gap = foot.dist + r_gen - pin.radius;
-                if gap >= 0.0 {
+                let Some(pc) = pin_contact(d, pin, o, th, t, (k, j))? else {
                     sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
                     continue;
-                }
-                let pen = -gap;
+                };
+                let pen = pc.penetration;
                 if !(pen < self.max_penetration) {
-                    return Err(penetration_error(
-                        t,
-                        pen,
-                        self.max_penetration,
-                        &format!("pin {} on disc {k}", j + 1),
-                    ));
+                    let what = format!("pin {} on disc {k}", j + 1);
+                    return Err(penetration_error(t, pen, self.max_penetration, &what));
                 }
-                // Normal and contact point in the fixed frame.
-                let nl = d.geometry.apply_rotation_mod(foot.normal);
-                let n = [c * nl[0] - s * nl[1], s * nl[0] + c * nl[1]];
-                let pl = d.geometry.apply_rotation_mod([
-                    foot.centre_point[0] - r_gen * foot.normal[0],
-                    foot.centre_point[1] - r_gen * foot.normal[1],
-                ]);
-                let rel = [c * pl[0] - s * pl[1], s * pl[0] + c * pl[1]];
-                // Lever of N about the disc centre and about the axis (through O_k).
-                let lever_c = rel[0] * n[1] - rel[1] * n[0];
+                // Levers of the normal about the disc centre (carrier DOF) and about the axis
+                // through O_k (crank DOF).
+                let n = pc.normal;
+                let lever_c = pc.lever();
                 let lever_a = o[0] * n[1] - o[1] * n[0];
                 let pen_rate = lever_c * vc + lever_a * va;
                 let f = self.pin_law.force(pen, pen_rate);
                 out.q[CARRIER] -= f * lever_c;
                 out.q[CRANK] -= f * lever_a;
-                let elastic = self.pin_law.elastic_force(pen);
-                out.dissipation += (f - elastic) * pen_rate;
+                out.dissipation += (f - self.pin_law.elastic_force(pen)) * pen_rate;
                 if want_energy {
                     out.potential += self.pin_law.elastic_energy(pen);
                 }
-                let point = [o[0] + rel[0], o[1] + rel[1]];
+                let point = [o[0] + pc.arm[0], o[1] + pc.arm[1]];
                 // Moment of the pin's force (-f n) on the disc about the disc centre.
                 sink.pin(k, j, f, pen, -f * lever_c, point, n);
             }
@@ -390,14 +363,6 @@ impl RigidModel {
             .map(|i| 0.5 * self.mass[i] * v[i] * v[i])
             .sum()
     }
-}
-
-fn penetration_error(t: f64, pen: f64, bound: f64, what: &str) -> RvdynError {
-    RvdynError::Simulation(format!(
-        "penetration {pen:.3e} m of {what} at t = {t:.6e} s exceeds the physical bound \
-         {bound:.3e} m: the run has gone unstable; reduce the step (dt) or tolerances, or use \
-         the implicit integrator"
-    ))
 }
 
 /// Mass properties from the scene or from simple steel solids (stated in each line).

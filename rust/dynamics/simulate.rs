@@ -1,8 +1,9 @@
 //! The simulation driver: integrate a scene to `t_end`, recording at fixed sample times.
 
+use crate::dynamics::model::ReducerModel;
 use crate::dynamics::record::{Channel, Recorder, Recording};
 use crate::dynamics::rigid::RigidModel;
-use crate::dynamics::scene::Scene;
+use crate::dynamics::scene::{Joints, Scene};
 use crate::dynamics::system::RigidSystem;
 use crate::error::{Result, RvdynError};
 use crate::solve::dopri5::Dopri5;
@@ -124,26 +125,29 @@ impl RunControl {
 /// what happened, when, and what would help), `Interrupted` when `control` asked to stop.
 pub fn simulate(scene: &Scene, options: &SimOptions, control: &RunControl) -> Result<Recording> {
     options.validate()?;
-    let model = RigidModel::new(scene)?;
-    run(&model, options, control)
+    match scene.joints {
+        Joints::Rigid => {
+            let model = RigidModel::new(scene)?;
+            run(&RigidSystem::new(&model), options, control)
+        }
+        Joints::Compliant { .. } => {
+            let model = crate::dynamics::compliant::CompliantModel::new(scene)?;
+            run(&model, options, control)
+        }
+    }
 }
 
 /// Integrate a built model.
-pub fn run(model: &RigidModel, opt: &SimOptions, control: &RunControl) -> Result<Recording> {
-    let sys = RigidSystem::new(model);
-    let (x0, v0) = model.initial_state();
-    let q0: Vec<f64> = model.free.iter().map(|&i| x0[i]).collect();
-    let v0f: Vec<f64> = model.free.iter().map(|&i| v0[i]).collect();
-    let mut st = State::new(&sys, 0.0, q0, v0f)?;
+pub fn run<M: ReducerModel>(sys: &M, opt: &SimOptions, control: &RunControl) -> Result<Recording> {
+    opt.validate()?;
+    let (q0, v0) = sys.initial_state();
+    let mut st = State::new(sys, 0.0, q0, v0)?;
     let interval = opt.sample_interval();
     let n_samples = (opt.t_end / interval + 1e-9).floor() as usize + 1;
-    let mut rec = Recorder::new(model, &opt.channels, n_samples);
+    let mut rec = Recorder::new(sys.layout(), &opt.channels, n_samples);
     let track_work = opt.channels.contains(&Channel::Energy);
     let mut next_sample = 0usize;
-    let record = |rec: &mut Recorder, s: &State| -> Result<()> {
-        let (x, v, acc) = sys.full(s.t, &s.q, &s.v);
-        rec.sample(model, s.t, &x, &v, acc, s.work)
-    };
+    let record = |rec: &mut Recorder, s: &State| -> Result<()> { rec.sample(sys, s.t, &s.q, &s.v, s.work) };
     let dt = opt.dt.unwrap_or_else(|| SimOptions::default_dt(opt.method));
     let mut rk4 = Rk4::default();
     let mut dopri = Dopri5::new(opt.rtol, opt.atol, dt, interval.max(dt));
@@ -161,9 +165,9 @@ pub fn run(model: &RigidModel, opt: &SimOptions, control: &RunControl) -> Result
         }
         let prev = st.clone();
         match opt.method {
-            Method::Rk4 => rk4.step(&sys, &mut st, h_fixed)?,
-            Method::GeneralizedAlpha => galpha.step(&sys, &mut st, h_fixed)?,
-            Method::Dopri5 => dopri.step(&sys, &mut st, opt.t_end)?,
+            Method::Rk4 => rk4.step(sys, &mut st, h_fixed)?,
+            Method::GeneralizedAlpha => galpha.step(sys, &mut st, h_fixed)?,
+            Method::Dopri5 => dopri.step(sys, &mut st, opt.t_end)?,
         }
         steps += 1;
         if matches!(opt.method, Method::Rk4 | Method::GeneralizedAlpha) && steps == n_fixed {

@@ -1,7 +1,8 @@
 //! The rigid-joint model seen by the integrators: free coordinates only.
 
-use crate::dynamics::rigid::{CARRIER, RigidModel};
-use crate::dynamics::sink::NoSink;
+use crate::dynamics::model::{Layout, Observation, ReducerModel};
+use crate::dynamics::rigid::{CARRIER, CRANK, RigidModel, SUN};
+use crate::dynamics::sink::{ContactSink, NoSink};
 use crate::error::Result;
 use crate::solve::MechanicalSystem;
 
@@ -63,5 +64,63 @@ impl MechanicalSystem for RigidSystem<'_> {
 
     fn length_scale(&self) -> &[f64] {
         &self.scale
+    }
+}
+
+impl ReducerModel for RigidSystem<'_> {
+    fn layout(&self) -> Layout {
+        let m = self.model;
+        Layout {
+            discs: m.discs.len(),
+            pins: m.pins.len(),
+            cranks: m.cranks,
+            meshes: m.mesh.map_or(0, |x| x.count),
+        }
+    }
+
+    fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
+        let (x, v) = self.model.initial_state();
+        let free = &self.model.free;
+        (free.iter().map(|&i| x[i]).collect(), free.iter().map(|&i| v[i]).collect())
+    }
+
+    fn observe(&self, t: f64, q: &[f64], v: &[f64], sink: &mut dyn ContactSink) -> Result<Observation> {
+        let m = self.model;
+        let (x, xv, acc) = self.full(t, q, v);
+        let f = m.forces(t, &x, &xv, &mut DynSink(sink))?;
+        let input_torque = match (m.prescribed, m.drive.torque(t)) {
+            (Some(p), _) => m.mass[p] * acc - f.q[p],
+            (None, Some(tq)) => tq,
+            (None, None) => 0.0,
+        };
+        let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = (0..m.discs.len()).map(|k| m.disc_pose(k, &x)).unzip();
+        Ok(Observation {
+            sun_angle: x[SUN],
+            sun_speed: xv[SUN],
+            carrier_angle: x[CARRIER],
+            carrier_speed: xv[CARRIER],
+            crank_angle: vec![x[CRANK]; m.cranks],
+            crank_speed: vec![xv[CRANK]; m.cranks],
+            disc_center: centres,
+            disc_angle: angles,
+            input_torque,
+            kinetic_energy: m.kinetic_energy(&xv),
+            potential_energy: f.potential,
+        })
+    }
+}
+
+/// Lets the generic hot-path force routine report into a dynamic sink when recording.
+struct DynSink<'a>(&'a mut dyn ContactSink);
+
+impl ContactSink for DynSink<'_> {
+    fn wants_energy(&self) -> bool {
+        self.0.wants_energy()
+    }
+    fn pin(&mut self, k: usize, j: usize, force: f64, pen: f64, moment: f64, point: [f64; 2], normal: [f64; 2]) {
+        self.0.pin(k, j, force, pen, moment, point, normal);
+    }
+    fn mesh(&mut self, i: usize, force: f64, deflection: f64) {
+        self.0.mesh(i, force, deflection);
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::dynamics::record::{Channel, Recording};
 use crate::dynamics::rigid::RigidModel;
-use crate::dynamics::simulate::{RunControl, SimOptions, run};
+use crate::dynamics::simulate::{RunControl, SimOptions};
 use crate::dynamics::scene::Scene;
 use crate::error::RvdynError;
 use crate::solve::Method;
@@ -136,11 +136,10 @@ fn simulate<'py>(
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
     let sc = scene(scene_json)?;
     let opt = options(t_end, integrator, dt, rtol, atol, rho_inf, record_interval, max_samples, channels)?;
-    let model = RigidModel::new(&sc)?;
     let control = RunControl::default();
     let start = Instant::now();
     let outcome = std::thread::scope(|s| -> PyResult<Result<Recording, RvdynError>> {
-        let worker = s.spawn(|| run(&model, &opt, &control));
+        let worker = s.spawn(|| crate::dynamics::simulate(&sc, &opt, &control));
         let mut last_draw = Instant::now();
         loop {
             py.detach(|| {
@@ -226,7 +225,7 @@ fn sweep<'py>(
                 .par_iter()
                 .map(|sc| {
                     let start = Instant::now();
-                    let r = RigidModel::new(sc).and_then(|m| run(&m, &opt, &RunControl::default()));
+                    let r = crate::dynamics::simulate(sc, &opt, &RunControl::default());
                     (r, start.elapsed().as_secs_f64())
                 })
                 .collect()
