@@ -32,7 +32,7 @@ pub struct Observation {
 }
 
 /// A reducer model the driver can integrate and record.
-pub trait ReducerModel: MechanicalSystem + Sync {
+pub trait ReducerModel: MechanicalSystem {
     fn layout(&self) -> Layout;
     /// Free coordinates and velocities at t = 0.
     fn initial_state(&self) -> (Vec<f64>, Vec<f64>);

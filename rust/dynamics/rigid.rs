@@ -14,10 +14,11 @@
 
 use crate::contact::ImpactLaw;
 use crate::dynamics::drive::DriveProfile;
-use crate::dynamics::pin_contact::{penetration_error, pin_contact};
+use crate::dynamics::pin_contact::{DiscPose, penetration_error, pin_contact};
 use crate::dynamics::scene::{Initial, Joints, Load, Scene};
 use crate::dynamics::sink::ContactSink;
 use crate::error::{Result, RvdynError};
+use std::cell::Cell;
 use crate::geometry::CycloidGeometry;
 use crate::geometry::mass::{DiscHoles, MassProperties, disc_mass_properties, solid_cylinder};
 
@@ -106,6 +107,8 @@ pub struct RigidModel {
     pub length_scale: [f64; 3],
     /// Penetration beyond which a run is declared unstable [m].
     pub max_penetration: f64,
+    /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start).
+    pub warm_seeds: Vec<Cell<f64>>,
 }
 
 impl RigidModel {
@@ -204,6 +207,7 @@ impl RigidModel {
             length_scale,
             // A tenth of the pin radius is far beyond any elastic approach of steel.
             max_penetration: 0.1 * cyc.pin_radius,
+            warm_seeds: vec![Cell::new(f64::NAN); scene.discs.len() * zp],
         })
     }
 
@@ -279,8 +283,10 @@ impl RigidModel {
         let va = v[CRANK];
         for (k, d) in self.discs.iter().enumerate() {
             let (o, th) = self.disc_pose(k, x);
+            let pose = DiscPose::new(o, th);
             for (j, pin) in self.pins.iter().enumerate() {
-                let Some(pc) = pin_contact(d, pin, o, th, t, (k, j))? else {
+                let warm = &self.warm_seeds[k * self.pins.len() + j];
+                let Some(pc) = pin_contact(d, pin, &pose, t, (k, j), warm)? else {
                     sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
                     continue;
                 };

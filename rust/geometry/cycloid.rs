@@ -195,7 +195,9 @@ impl CycloidGeometry {
     #[inline]
     pub(crate) fn jet(&self, phi: f64) -> CurveJet {
         let (s1, c1) = phi.sin_cos();
-        let (sz, cz) = (self.zp * phi).sin_cos();
+        // (cos zp phi, sin zp phi) as the zp-th power of (cos phi, sin phi): half the cost of a
+        // second sin_cos, relative error ~zp * eps (1e-17 m at the default eccentricity).
+        let (cz, sz) = complex_pow(c1, s1, self.params.pins);
         let r = self.gen_radius;
         let e = self.params.eccentricity;
         let ez = e * self.zp;
@@ -210,7 +212,8 @@ impl CycloidGeometry {
     /// Outward unit normal of the curve at `phi` from its tangent (unrotated disc frame).
     #[inline]
     pub(crate) fn normal_from_tangent(d1: [f64; 2]) -> [f64; 2] {
-        let len = d1[0].hypot(d1[1]);
+        // |C'| = rp S >= rp (1 - K1) > 0: no overflow or underflow, so no need for hypot.
+        let len = (d1[0] * d1[0] + d1[1] * d1[1]).sqrt();
         [d1[1] / len, -d1[0] / len]
     }
 
@@ -296,6 +299,21 @@ impl CycloidGeometry {
         }
         (area, polar)
     }
+}
+
+/// `(c + i s)^n` by binary exponentiation.
+#[inline]
+fn complex_pow(c: f64, s: f64, mut n: u32) -> (f64, f64) {
+    let (mut rc, mut rs) = (1.0, 0.0);
+    let (mut bc, mut bs) = (c, s);
+    while n > 0 {
+        if n & 1 == 1 {
+            (rc, rs) = (rc * bc - rs * bs, rc * bs + rs * bc);
+        }
+        (bc, bs) = (bc * bc - bs * bs, 2.0 * bc * bs);
+        n >>= 1;
+    }
+    (rc, rs)
 }
 
 /// Minimum convex radius of curvature of the pin-centre curve [m].
