@@ -54,7 +54,7 @@ impl SimOptions {
         match method {
             Method::Rk4 => 1e-5,
             Method::Dopri5 => 1e-6,
-            Method::GeneralizedAlpha => 2e-5,
+            Method::GeneralizedAlpha => 1e-4,
         }
     }
 
