@@ -68,6 +68,7 @@ pub struct Recording {
 /// Collects the contacts of one evaluation into per-sample buffers.
 pub(crate) struct SampleSink {
     pub zp: usize,
+    pub forces: bool,
     pub pins: bool,
     pub points: bool,
     pub energy: bool,
@@ -83,6 +84,9 @@ pub(crate) struct SampleSink {
 impl ContactSink for SampleSink {
     fn wants_energy(&self) -> bool {
         self.energy
+    }
+    fn wants_forces(&self) -> bool {
+        self.forces
     }
     fn pin(
         &mut self,
@@ -178,6 +182,7 @@ impl Recorder {
         }
         let sink = SampleSink {
             zp,
+            forces: channels.iter().any(|c| *c != Channel::Motion),
             pins: has(Channel::Pins),
             points: has(Channel::ContactPoints),
             energy: has(Channel::Energy),

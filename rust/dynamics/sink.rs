@@ -7,6 +7,11 @@ pub trait ContactSink {
     fn wants_energy(&self) -> bool {
         false
     }
+    /// Whether contact forces are wanted at all: a recorder of motion only says no, and the
+    /// model then skips the force evaluation when it observes a state.
+    fn wants_forces(&self) -> bool {
+        true
+    }
     /// Pin `j` on disc `k`: normal force [N], penetration [m], moment of the pin force about
     /// the disc centre [N m], contact point and unit outward profile normal (fixed frame).
     #[allow(clippy::too_many_arguments)]

@@ -1,7 +1,7 @@
 //! The rigid-joint model seen by the integrators: free coordinates only.
 
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
-use crate::dynamics::rigid::{CARRIER, CRANK, RigidModel, SUN};
+use crate::dynamics::rigid::{CARRIER, CRANK, Forces, RigidModel, SUN};
 use crate::dynamics::sink::{ContactSink, NoSink};
 use crate::error::Result;
 use crate::solve::MechanicalSystem;
@@ -87,7 +87,11 @@ impl ReducerModel for RigidSystem<'_> {
     fn observe(&self, t: f64, q: &[f64], v: &[f64], sink: &mut dyn ContactSink) -> Result<Observation> {
         let m = self.model;
         let (x, xv, acc) = self.full(t, q, v);
-        let f = m.forces(t, &x, &xv, &mut DynSink(sink))?;
+        let f = if sink.wants_forces() {
+            m.forces(t, &x, &xv, &mut DynSink(sink))?
+        } else {
+            Forces::default()
+        };
         let input_torque = match (m.prescribed, m.drive.torque(t)) {
             (Some(p), _) => m.mass[p] * acc - f.q[p],
             (None, Some(tq)) => tq,
@@ -116,6 +120,9 @@ struct DynSink<'a>(&'a mut dyn ContactSink);
 impl ContactSink for DynSink<'_> {
     fn wants_energy(&self) -> bool {
         self.0.wants_energy()
+    }
+    fn wants_forces(&self) -> bool {
+        self.0.wants_forces()
     }
     fn pin(&mut self, k: usize, j: usize, force: f64, pen: f64, moment: f64, point: [f64; 2], normal: [f64; 2]) {
         self.0.pin(k, j, force, pen, moment, point, normal);
