@@ -41,8 +41,8 @@ impl PinContact {
     }
 }
 
-/// Exact contact of `pin` with `disc` at `pose`;
-/// `None` when they do not touch.
+/// Exact signed contact of `pin` with `disc` at `pose`: `penetration = -gap`, negative when
+/// they do not touch.
 ///
 /// Newton starts from `warm` (the foot parameter this pin had at the previous evaluation) when
 /// it is within 0.05 rad of the kinematic parameter (pin angle minus disc angle), else from the
@@ -50,14 +50,14 @@ impl PinContact {
 /// the seed (Newton converges to 1e-13 m on the exact curve): the warm start only saves
 /// iterations. `warm` is updated.
 #[inline]
-pub fn pin_contact(
+pub fn pin_query(
     disc: &DiscModel,
     pin: &PinModel,
     pose: &DiscPose,
     t: f64,
     labels: (usize, usize),
     warm: &Cell<f64>,
-) -> Result<Option<PinContact>> {
+) -> Result<PinContact> {
     let g = &disc.geometry;
     let (centre, angle, s, c) = (pose.centre, pose.angle, pose.sin, pose.cos);
     let dp = [pin.centre[0] - centre[0], pin.centre[1] - centre[1]];
@@ -75,19 +75,31 @@ pub fn pin_contact(
     warm.set(foot.phi);
     let r_gen = g.generating_pin_radius();
     let gap = foot.dist + r_gen - pin.radius;
-    if gap >= 0.0 {
-        return Ok(None);
-    }
     let nl = g.apply_rotation_mod(foot.normal);
     let pl = g.apply_rotation_mod([
         foot.centre_point[0] - r_gen * foot.normal[0],
         foot.centre_point[1] - r_gen * foot.normal[1],
     ]);
-    Ok(Some(PinContact {
+    Ok(PinContact {
         penetration: -gap,
         normal: [c * nl[0] - s * nl[1], s * nl[0] + c * nl[1]],
         arm: [c * pl[0] - s * pl[1], s * pl[0] + c * pl[1]],
-    }))
+    })
+}
+
+/// Exact contact of `pin` with `disc` at `pose`; `None` when they do not touch. See
+/// [`pin_query`] for the seeding.
+#[inline]
+pub fn pin_contact(
+    disc: &DiscModel,
+    pin: &PinModel,
+    pose: &DiscPose,
+    t: f64,
+    labels: (usize, usize),
+    warm: &Cell<f64>,
+) -> Result<Option<PinContact>> {
+    let q = pin_query(disc, pin, pose, t, labels, warm)?;
+    Ok((q.penetration > 0.0).then_some(q))
 }
 
 /// The error raised when a penetration exceeds the physical bound.

@@ -14,7 +14,7 @@
 
 use crate::contact::ImpactLaw;
 use crate::dynamics::drive::DriveProfile;
-use crate::dynamics::pin_contact::{DiscPose, penetration_error, pin_contact};
+use crate::dynamics::pin_contact::{DiscPose, penetration_error, pin_query};
 use crate::dynamics::scene::{Initial, Joints, Load, Scene};
 use crate::dynamics::sink::ContactSink;
 use crate::error::{Result, RvdynError};
@@ -109,6 +109,22 @@ pub struct RigidModel {
     pub max_penetration: f64,
     /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start).
     pub warm_seeds: Vec<Cell<f64>>,
+    /// Skip the exact query of a pin that provably cannot touch (see [`SeparationBound`]).
+    pub skip_separated: bool,
+    separation: Vec<Cell<SeparationBound>>,
+    /// Largest distance of a profile point from its disc centre [m].
+    profile_reach: f64,
+}
+
+/// The last exact gap of one (disc, pin) pair and the disc pose it was computed at. Moving a
+/// disc by `dO` and turning it by `dth` moves every profile point by at most
+/// `|dO| + reach |dth|`, and the gap by no more: while `gap - that > 0` the pin cannot touch and
+/// its exact query is skipped. The answer is the same as without skipping (tested).
+#[derive(Debug, Clone, Copy)]
+struct SeparationBound {
+    centre: [f64; 2],
+    angle: f64,
+    gap: f64,
 }
 
 impl RigidModel {
@@ -208,6 +224,18 @@ impl RigidModel {
             // A tenth of the pin radius is far beyond any elastic approach of steel.
             max_penetration: 0.1 * cyc.pin_radius,
             warm_seeds: vec![Cell::new(f64::NAN); scene.discs.len() * zp],
+            skip_separated: true,
+            separation: vec![
+                Cell::new(SeparationBound { centre: [0.0; 2], angle: 0.0, gap: f64::NEG_INFINITY });
+                scene.discs.len() * zp
+            ],
+            profile_reach: (0..scene.discs.len())
+                .map(|k| {
+                    let p = scene.disc_params(k);
+                    p.pin_circle_radius + p.d_rp + p.eccentricity - p.pin_radius - p.d_rrp
+                })
+                .fold(0.0, f64::max)
+                * 1.000_001,
         })
     }
 
@@ -285,11 +313,24 @@ impl RigidModel {
             let (o, th) = self.disc_pose(k, x);
             let pose = DiscPose::new(o, th);
             for (j, pin) in self.pins.iter().enumerate() {
-                let warm = &self.warm_seeds[k * self.pins.len() + j];
-                let Some(pc) = pin_contact(d, pin, &pose, t, (k, j), warm)? else {
+                let idx = k * self.pins.len() + j;
+                if self.skip_separated {
+                    let b = self.separation[idx].get();
+                    let moved = (o[0] - b.centre[0]).hypot(o[1] - b.centre[1])
+                        + self.profile_reach * (th - b.angle).abs();
+                    if b.gap > moved {
+                        sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
+                        continue;
+                    }
+                }
+                let pc = pin_query(d, pin, &pose, t, (k, j), &self.warm_seeds[idx])?;
+                if self.skip_separated {
+                    self.separation[idx].set(SeparationBound { centre: o, angle: th, gap: -pc.penetration });
+                }
+                if pc.penetration <= 0.0 {
                     sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
                     continue;
-                };
+                }
                 let pen = pc.penetration;
                 if !(pen < self.max_penetration) {
                     let what = format!("pin {} on disc {k}", j + 1);

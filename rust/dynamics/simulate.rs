@@ -31,6 +31,8 @@ pub struct SimOptions {
     /// Largest number of samples kept (memory bound: the interval is coarsened to fit).
     pub max_samples: usize,
     pub channels: Vec<Channel>,
+    /// Skip the exact query of pins that provably cannot touch (exact: same answer).
+    pub skip_separated: bool,
 }
 
 impl SimOptions {
@@ -46,6 +48,7 @@ impl SimOptions {
             record_interval: None,
             max_samples: 50_000,
             channels: Channel::defaults(),
+            skip_separated: true,
         }
     }
 
@@ -127,7 +130,8 @@ pub fn simulate(scene: &Scene, options: &SimOptions, control: &RunControl) -> Re
     options.validate()?;
     match scene.joints {
         Joints::Rigid => {
-            let model = RigidModel::new(scene)?;
+            let mut model = RigidModel::new(scene)?;
+            model.skip_separated = options.skip_separated;
             run(&RigidSystem::new(&model), options, control)
         }
         Joints::Compliant { .. } => {

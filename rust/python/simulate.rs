@@ -73,6 +73,7 @@ fn options(
     record_interval: Option<f64>,
     max_samples: Option<usize>,
     channels: Option<Vec<String>>,
+    skip_separated: bool,
 ) -> Result<SimOptions, RvdynError> {
     let mut o = SimOptions::new(t_end, Method::parse(integrator)?);
     o.dt = dt;
@@ -92,6 +93,7 @@ fn options(
     if let Some(ch) = channels {
         o.channels = ch.iter().map(|c| Channel::parse(c)).collect::<Result<_, _>>()?;
     }
+    o.skip_separated = skip_separated;
     Ok(o)
 }
 
@@ -118,7 +120,7 @@ fn to_python<'py>(py: Python<'py>, rec: Recording) -> PyResult<(Bound<'py, PyDic
 /// progress bar on stderr when `progress` is true.
 #[pyfunction]
 #[pyo3(signature = (scene_json, t_end, integrator, dt=None, rtol=None, atol=None, rho_inf=None,
-    record_interval=None, max_samples=None, channels=None, progress=false))]
+    record_interval=None, max_samples=None, channels=None, progress=false, skip_separated=true))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -133,9 +135,10 @@ fn simulate<'py>(
     max_samples: Option<usize>,
     channels: Option<Vec<String>>,
     progress: bool,
+    skip_separated: bool,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
     let sc = scene(scene_json)?;
-    let opt = options(t_end, integrator, dt, rtol, atol, rho_inf, record_interval, max_samples, channels)?;
+    let opt = options(t_end, integrator, dt, rtol, atol, rho_inf, record_interval, max_samples, channels, skip_separated)?;
     let control = RunControl::default();
     let start = Instant::now();
     let outcome = std::thread::scope(|s| -> PyResult<Result<Recording, RvdynError>> {
@@ -197,7 +200,7 @@ fn draw_progress(t: f64, t_end: f64, wall: f64) {
 /// recorded arrays and statistics or the exception its run raised.
 #[pyfunction]
 #[pyo3(signature = (scene_jsons, t_end, integrator, dt=None, rtol=None, atol=None, rho_inf=None,
-    record_interval=None, max_samples=None, channels=None, threads=None))]
+    record_interval=None, max_samples=None, channels=None, threads=None, skip_separated=true))]
 #[allow(clippy::too_many_arguments)]
 fn sweep<'py>(
     py: Python<'py>,
@@ -212,8 +215,9 @@ fn sweep<'py>(
     max_samples: Option<usize>,
     channels: Option<Vec<String>>,
     threads: Option<usize>,
+    skip_separated: bool,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let opt = options(t_end, integrator, dt, rtol, atol, rho_inf, record_interval, max_samples, channels)?;
+    let opt = options(t_end, integrator, dt, rtol, atol, rho_inf, record_interval, max_samples, channels, skip_separated)?;
     let scenes: Vec<Scene> = scene_jsons.iter().map(|j| scene(j)).collect::<PyResult<_>>()?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
