@@ -106,7 +106,8 @@ pub fn pin_contact(
 pub fn penetration_error(t: f64, pen: f64, bound: f64, what: &str) -> RvdynError {
     RvdynError::Simulation(format!(
         "penetration {pen:.3e} m of {what} at t = {t:.6e} s exceeds the physical bound \
-         {bound:.3e} m: the run has gone unstable; reduce the step (dt) or tolerances, or use \
-         the implicit integrator"
+         {bound:.3e} m (a tenth of the pin radius): either the run has gone unstable (reduce the \
+         step dt or the tolerances, or use integrator=\"generalized-alpha\") or the contact is \
+         too soft for the load (raise the contact stiffness)"
     ))
 }

@@ -88,6 +88,9 @@ impl ContactSink for SampleSink {
     fn wants_forces(&self) -> bool {
         self.forces
     }
+    fn checks_bounds(&self) -> bool {
+        false
+    }
     fn pin(
         &mut self,
         k: usize,

@@ -307,6 +307,7 @@ impl RigidModel {
     ) -> Result<Forces> {
         let mut out = Forces::default();
         let want_energy = sink.wants_energy();
+        let check = sink.checks_bounds();
         let vc = v[CARRIER];
         let va = v[CRANK];
         for (k, d) in self.discs.iter().enumerate() {
@@ -332,7 +333,7 @@ impl RigidModel {
                     continue;
                 }
                 let pen = pc.penetration;
-                if !(pen < self.max_penetration) {
+                if check && !(pen < self.max_penetration) {
                     let what = format!("pin {} on disc {k}", j + 1);
                     return Err(penetration_error(t, pen, self.max_penetration, &what));
                 }
@@ -369,7 +370,7 @@ impl RigidModel {
                 (0.0, 0.0, 0.0, 0.0)
             };
             if pen > 0.0 {
-                if !(pen < self.max_penetration) {
+                if check && !(pen < self.max_penetration) {
                     return Err(penetration_error(
                         t,
                         pen,

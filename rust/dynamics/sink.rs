@@ -12,6 +12,12 @@ pub trait ContactSink {
     fn wants_forces(&self) -> bool {
         true
     }
+    /// Whether a penetration beyond the physical bound is an error. The integrator's
+    /// evaluations say yes (it detects instability); a recorder observing an interpolated state
+    /// between two accepted steps says no.
+    fn checks_bounds(&self) -> bool {
+        true
+    }
     /// Pin `j` on disc `k`: normal force [N], penetration [m], moment of the pin force about
     /// the disc centre [N m], contact point and unit outward profile normal (fixed frame).
     #[allow(clippy::too_many_arguments)]

@@ -124,6 +124,9 @@ impl ContactSink for DynSink<'_> {
     fn wants_forces(&self) -> bool {
         self.0.wants_forces()
     }
+    fn checks_bounds(&self) -> bool {
+        self.0.checks_bounds()
+    }
     fn pin(&mut self, k: usize, j: usize, force: f64, pen: f64, moment: f64, point: [f64; 2], normal: [f64; 2]) {
         self.0.pin(k, j, force, pen, moment, point, normal);
     }
