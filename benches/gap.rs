@@ -32,7 +32,9 @@ fn bench_gap(c: &mut Criterion) {
         b.iter(|| {
             let mut s = 0.0;
             for p in &pins {
-                s += g.gap(black_box(*p), black_box(centre), black_box(angle)).map_or(0.0, |r| r.gap);
+                s += g
+                    .gap(black_box(*p), black_box(centre), black_box(angle))
+                    .map_or(0.0, |r| r.gap);
             }
             s
         })
@@ -43,7 +45,13 @@ fn bench_gap(c: &mut Criterion) {
             for (j, p) in pins.iter().enumerate() {
                 let seed = g.pin_angle(j) - angle;
                 s += g
-                    .gap_seeded(black_box(*p), 0.01, black_box(centre), black_box(angle), seed)
+                    .gap_seeded(
+                        black_box(*p),
+                        0.01,
+                        black_box(centre),
+                        black_box(angle),
+                        seed,
+                    )
                     .map_or(0.0, |r| r.gap);
             }
             s

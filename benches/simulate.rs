@@ -30,7 +30,15 @@ fn bench_dynamics(c: &mut Criterion) {
     let mut a = vec![0.0; sys.dof()];
     let mut p = [0.0; 3];
     c.bench_function("rhs/rigid_rated_48_pins_3_meshes", |b| {
-        b.iter(|| sys.eval(black_box(st.t), black_box(&st.q), black_box(&st.v), &mut a, &mut p))
+        b.iter(|| {
+            sys.eval(
+                black_box(st.t),
+                black_box(&st.q),
+                black_box(&st.v),
+                &mut a,
+                &mut p,
+            )
+        })
     });
     let mut rk4 = Rk4::default();
     c.bench_function("step/rk4_dt_1e-5", |b| {

@@ -60,7 +60,7 @@ class Scene:
         self._data: dict[str, Any] = json.loads(_core.scene_validate(text))
 
     @classmethod
-    def paper(cls, load: str = "paper", **changes: Any) -> "Scene":
+    def paper(cls, load: str = "paper", /, **changes: Any) -> "Scene":
         """The default scene (design.md section 7) at 8328 deg/s with a step start from rest.
 
         ``load``: ``"idle"``, ``"paper"`` (the printed 4024.9 N m on the output) or
@@ -69,6 +69,20 @@ class Scene:
         """
         scene = cls(json.loads(_core.scene_paper(load)))
         return scene.replace(**changes) if changes else scene
+
+    def with_compliant_joints(self, eccentric_bearing: dict[str, float] | None = None,
+                              crank_bearing: dict[str, float] | None = None) -> "Scene":
+        """This scene with compliant joints: spring-damper bearings between each eccentric and
+        its disc hole and between each crank and the carrier (``{stiffness [N/m], damping
+        [N s/m], clearance [m]}``); the discs and crank centres then move freely. Defaults are
+        the assumed values of ``rvdyn._core.default_compliant_joints()`` (eccentric needle
+        bearing 1e9 N/m, 1e4 N s/m; crank bearing 2e9 N/m, 1e4 N s/m; no clearance)."""
+        joints = json.loads(_core.default_compliant_joints())
+        if eccentric_bearing:
+            joints["eccentric_bearing"].update(eccentric_bearing)
+        if crank_bearing:
+            joints["crank_bearing"].update(crank_bearing)
+        return self.replace(joints=joints)
 
     def to_dict(self) -> dict[str, Any]:
         """A deep copy of the scene as a plain dictionary (SI values)."""

@@ -37,5 +37,11 @@ pub trait ReducerModel: MechanicalSystem {
     /// Free coordinates and velocities at t = 0.
     fn initial_state(&self) -> (Vec<f64>, Vec<f64>);
     /// Observe the state `(q, v)` at `t`, reporting every contact to `sink`.
-    fn observe(&self, t: f64, q: &[f64], v: &[f64], sink: &mut dyn ContactSink) -> Result<Observation>;
+    fn observe(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        sink: &mut dyn ContactSink,
+    ) -> Result<Observation>;
 }

@@ -18,7 +18,12 @@ pub struct DiscPose {
 impl DiscPose {
     pub fn new(centre: [f64; 2], angle: f64) -> Self {
         let (sin, cos) = angle.sin_cos();
-        Self { centre, angle, sin, cos }
+        Self {
+            centre,
+            angle,
+            sin,
+            cos,
+        }
     }
 }
 
@@ -63,7 +68,11 @@ pub fn pin_query(
     let dp = [pin.centre[0] - centre[0], pin.centre[1] - centre[1]];
     let local = g.remove_rotation_mod([c * dp[0] + s * dp[1], -s * dp[0] + c * dp[1]]);
     let kinematic = pin.angle - angle - g.params().d_delta;
-    let seed = if (warm.get() - kinematic).abs() < 0.05 { warm.get() } else { kinematic };
+    let seed = if (warm.get() - kinematic).abs() < 0.05 {
+        warm.get()
+    } else {
+        kinematic
+    };
     let foot = g.foot_with_fallback(local, seed).ok_or_else(|| {
         RvdynError::Convergence(format!(
             "exact gap of pin {} on disc {} not found at t = {t:.6e} s: the disc is far from \

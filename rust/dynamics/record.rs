@@ -217,7 +217,14 @@ impl Recorder {
     }
 
     /// Record the free state `(q, v)` at `t` with integrated `work`.
-    pub fn sample<M: ReducerModel>(&mut self, model: &M, t: f64, q: &[f64], v: &[f64], work: [f64; 3]) -> Result<()> {
+    pub fn sample<M: ReducerModel>(
+        &mut self,
+        model: &M,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        work: [f64; 3],
+    ) -> Result<()> {
         let channels = self.channels.clone();
         let has = |c| channels.contains(&c);
         let obs = model.observe(t, q, v, &mut self.sink)?;
@@ -237,9 +244,18 @@ impl Recorder {
         if has(Channel::Pins) {
             let zp = self.sink.zp;
             let loaded: Vec<f64> = (0..self.nd)
-                .map(|k| self.sink.force[k * zp..(k + 1) * zp].iter().filter(|f| **f > 0.0).count() as f64)
+                .map(|k| {
+                    self.sink.force[k * zp..(k + 1) * zp]
+                        .iter()
+                        .filter(|f| **f > 0.0)
+                        .count() as f64
+                })
                 .collect();
-            let (f, p, m) = (self.sink.force.clone(), self.sink.pen.clone(), self.sink.moment.clone());
+            let (f, p, m) = (
+                self.sink.force.clone(),
+                self.sink.pen.clone(),
+                self.sink.moment.clone(),
+            );
             self.push("pin_force", &f);
             self.push("pin_penetration", &p);
             self.push("pin_moment", &m);
@@ -251,7 +267,10 @@ impl Recorder {
             self.push("pin_normal", &nm);
         }
         if has(Channel::Mesh) {
-            let (mf, md) = (self.sink.mesh_force.clone(), self.sink.mesh_deflection.clone());
+            let (mf, md) = (
+                self.sink.mesh_force.clone(),
+                self.sink.mesh_deflection.clone(),
+            );
             self.push("mesh_force", &mf);
             self.push("mesh_deflection", &md);
             self.push("input_torque", &[obs.input_torque]);

@@ -18,9 +18,9 @@ use crate::dynamics::pin_contact::{DiscPose, penetration_error, pin_query};
 use crate::dynamics::scene::{Initial, Joints, Load, Scene};
 use crate::dynamics::sink::ContactSink;
 use crate::error::{Result, RvdynError};
-use std::cell::Cell;
 use crate::geometry::CycloidGeometry;
 use crate::geometry::mass::{DiscHoles, MassProperties, disc_mass_properties, solid_cylinder};
+use std::cell::Cell;
 
 /// Index of the carrier angle in the full coordinate vector.
 pub const CARRIER: usize = 0;
@@ -226,7 +226,11 @@ impl RigidModel {
             warm_seeds: vec![Cell::new(f64::NAN); scene.discs.len() * zp],
             skip_separated: true,
             separation: vec![
-                Cell::new(SeparationBound { centre: [0.0; 2], angle: 0.0, gap: f64::NEG_INFINITY });
+                Cell::new(SeparationBound {
+                    centre: [0.0; 2],
+                    angle: 0.0,
+                    gap: f64::NEG_INFINITY
+                });
                 scene.discs.len() * zp
             ],
             profile_reach: (0..scene.discs.len())
@@ -326,14 +330,18 @@ impl RigidModel {
                 }
                 let pc = pin_query(d, pin, &pose, t, (k, j), &self.warm_seeds[idx])?;
                 if self.skip_separated {
-                    self.separation[idx].set(SeparationBound { centre: o, angle: th, gap: -pc.penetration });
+                    self.separation[idx].set(SeparationBound {
+                        centre: o,
+                        angle: th,
+                        gap: -pc.penetration,
+                    });
                 }
                 if pc.penetration <= 0.0 {
                     sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
                     continue;
                 }
                 let pen = pc.penetration;
-                if check && !(pen < self.max_penetration) {
+                if check && (pen.is_nan() || pen >= self.max_penetration) {
                     let what = format!("pin {} on disc {k}", j + 1);
                     return Err(penetration_error(t, pen, self.max_penetration, &what));
                 }
@@ -370,7 +378,7 @@ impl RigidModel {
                 (0.0, 0.0, 0.0, 0.0)
             };
             if pen > 0.0 {
-                if check && !(pen < self.max_penetration) {
+                if check && (pen.is_nan() || pen >= self.max_penetration) {
                     return Err(penetration_error(
                         t,
                         pen,

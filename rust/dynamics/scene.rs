@@ -402,10 +402,10 @@ impl Scene {
                 ("d_rrp", d.d_rrp),
                 ("d_delta", d.d_delta),
             ] {
-                if let Some(v) = v {
-                    if !v.is_finite() {
-                        return err(format!("discs[{k}].{n} must be finite, got {v}"));
-                    }
+                if let Some(v) = v
+                    && !v.is_finite()
+                {
+                    return err(format!("discs[{k}].{n} must be finite, got {v}"));
                 }
             }
             crate::geometry::CycloidGeometry::new(self.disc_params(k))?;
@@ -455,16 +455,15 @@ impl Scene {
             ("disc", i.disc),
             ("carrier", i.carrier),
         ] {
-            if let Some(mp) = mp {
-                if !(mp.mass.is_finite()
+            if let Some(mp) = mp
+                && !(mp.mass.is_finite()
                     && mp.mass > 0.0
                     && mp.inertia.is_finite()
                     && mp.inertia > 0.0)
-                {
-                    return err(format!(
-                        "inertias.{n} needs mass > 0 kg and inertia > 0 kg m^2, got {mp:?}"
-                    ));
-                }
+            {
+                return err(format!(
+                    "inertias.{n} needs mass > 0 kg and inertia > 0 kg m^2, got {mp:?}"
+                ));
             }
         }
         if !(i.load_inertia.is_finite() && i.load_inertia >= 0.0) {
@@ -515,7 +514,7 @@ impl Scene {
                 }
             }
             Drive::Torque { torque, ramp_time } => {
-                if !torque.is_finite() || !(ramp_time.is_finite() && ramp_time >= 0.0) {
+                if !(torque.is_finite() && ramp_time.is_finite() && ramp_time >= 0.0) {
                     return err(format!(
                         "drive.torque must be finite and ramp_time >= 0, got {torque}, {ramp_time}"
                     ));
@@ -594,9 +593,13 @@ mod tests {
                 let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
                 (x - y).abs() <= 4.0 * f64::EPSILON * x.abs().max(y.abs())
             }
-            (Array(x), Array(y)) => x.len() == y.len() && x.iter().zip(y).all(|(p, q)| json_close(p, q)),
+            (Array(x), Array(y)) => {
+                x.len() == y.len() && x.iter().zip(y).all(|(p, q)| json_close(p, q))
+            }
             (Object(x), Object(y)) => {
-                x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| json_close(v, w)))
+                x.len() == y.len()
+                    && x.iter()
+                        .all(|(k, v)| y.get(k).is_some_and(|w| json_close(v, w)))
             }
             _ => a == b,
         }

@@ -69,10 +69,10 @@ impl SimOptions {
                 self.t_end
             ));
         }
-        if let Some(dt) = self.dt {
-            if !(dt.is_finite() && dt > 0.0 && dt <= self.t_end) {
-                return bad(format!("dt must be > 0 s and <= t_end, got {dt}"));
-            }
+        if let Some(dt) = self.dt
+            && !(dt.is_finite() && dt > 0.0 && dt <= self.t_end)
+        {
+            return bad(format!("dt must be > 0 s and <= t_end, got {dt}"));
         }
         if !(self.rtol.is_finite() && self.rtol >= 0.0) {
             return bad(format!("rtol must be >= 0, got {}", self.rtol));
@@ -80,10 +80,10 @@ impl SimOptions {
         if !(self.atol.is_finite() && self.atol > 0.0) {
             return bad(format!("atol must be > 0 m, got {}", self.atol));
         }
-        if let Some(r) = self.record_interval {
-            if !(r.is_finite() && r > 0.0) {
-                return bad(format!("record_interval must be > 0 s, got {r}"));
-            }
+        if let Some(r) = self.record_interval
+            && !(r.is_finite() && r > 0.0)
+        {
+            return bad(format!("record_interval must be > 0 s, got {r}"));
         }
         if self.max_samples < 2 {
             return bad("max_samples must be at least 2".into());
@@ -151,7 +151,8 @@ pub fn run<M: ReducerModel>(sys: &M, opt: &SimOptions, control: &RunControl) -> 
     let mut rec = Recorder::new(sys.layout(), &opt.channels, n_samples);
     let track_work = opt.channels.contains(&Channel::Energy);
     let mut next_sample = 0usize;
-    let record = |rec: &mut Recorder, s: &State| -> Result<()> { rec.sample(sys, s.t, &s.q, &s.v, s.work) };
+    let record =
+        |rec: &mut Recorder, s: &State| -> Result<()> { rec.sample(sys, s.t, &s.q, &s.v, s.work) };
     let dt = opt.dt.unwrap_or_else(|| SimOptions::default_dt(opt.method));
     let mut rk4 = Rk4::default();
     let mut dopri = Dopri5::new(opt.rtol, opt.atol, dt, interval.max(dt));

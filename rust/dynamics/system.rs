@@ -81,10 +81,19 @@ impl ReducerModel for RigidSystem<'_> {
     fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
         let (x, v) = self.model.initial_state();
         let free = &self.model.free;
-        (free.iter().map(|&i| x[i]).collect(), free.iter().map(|&i| v[i]).collect())
+        (
+            free.iter().map(|&i| x[i]).collect(),
+            free.iter().map(|&i| v[i]).collect(),
+        )
     }
 
-    fn observe(&self, t: f64, q: &[f64], v: &[f64], sink: &mut dyn ContactSink) -> Result<Observation> {
+    fn observe(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        sink: &mut dyn ContactSink,
+    ) -> Result<Observation> {
         let m = self.model;
         let (x, xv, acc) = self.full(t, q, v);
         let f = if sink.wants_forces() {
@@ -97,7 +106,8 @@ impl ReducerModel for RigidSystem<'_> {
             (None, Some(tq)) => tq,
             (None, None) => 0.0,
         };
-        let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = (0..m.discs.len()).map(|k| m.disc_pose(k, &x)).unzip();
+        let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) =
+            (0..m.discs.len()).map(|k| m.disc_pose(k, &x)).unzip();
         Ok(Observation {
             sun_angle: x[SUN],
             sun_speed: xv[SUN],
@@ -127,7 +137,16 @@ impl ContactSink for DynSink<'_> {
     fn checks_bounds(&self) -> bool {
         self.0.checks_bounds()
     }
-    fn pin(&mut self, k: usize, j: usize, force: f64, pen: f64, moment: f64, point: [f64; 2], normal: [f64; 2]) {
+    fn pin(
+        &mut self,
+        k: usize,
+        j: usize,
+        force: f64,
+        pen: f64,
+        moment: f64,
+        point: [f64; 2],
+        normal: [f64; 2],
+    ) {
         self.0.pin(k, j, force, pen, moment, point, normal);
     }
     fn mesh(&mut self, i: usize, force: f64, deflection: f64) {

@@ -140,7 +140,7 @@ impl CycloidGeometry {
             let f = r[0] * j.d1[0] + r[1] * j.d1[1];
             let d1sq = j.d1[0] * j.d1[0] + j.d1[1] * j.d1[1];
             let fp = d1sq + r[0] * j.d2[0] + r[1] * j.d2[1];
-            if !(fp > 0.0) {
+            if fp.is_nan() || fp <= 0.0 {
                 return None;
             }
             let step = (-f / fp).clamp(-max_step, max_step);

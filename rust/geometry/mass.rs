@@ -72,7 +72,7 @@ pub fn disc_mass_properties(
     for _ in 0..holes.pillar_holes {
         cut(circle(holes.pillar_hole_radius, holes.hole_circle_radius));
     }
-    if !(a > 0.0) {
+    if a.is_nan() || a <= 0.0 {
         return Err(RvdynError::Geometry(format!(
             "the disc holes remove all material (remaining area {a:.3e} m^2)"
         )));

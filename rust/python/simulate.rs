@@ -1,11 +1,13 @@
 //! Bindings for scenes and dynamic runs. The Python `rvdyn.Scene`, `rvdyn.simulate` and
 //! `rvdyn.Result` (python/rvdyn/) wrap these private functions.
 
+use crate::dynamics::compliant::{CompliantModel, default_joints};
 use crate::dynamics::record::{Channel, Recording};
 use crate::dynamics::rigid::RigidModel;
+use crate::dynamics::scene::{Joints, Scene};
 use crate::dynamics::simulate::{RunControl, SimOptions};
-use crate::dynamics::scene::Scene;
 use crate::error::RvdynError;
+use crate::solve::MechanicalSystem;
 use crate::solve::Method;
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::prelude::*;
@@ -42,13 +44,32 @@ fn scene_from_toml(text: &str) -> PyResult<String> {
     Ok(Scene::from_toml(text)?.to_json()?)
 }
 
+/// The default compliant joints (assumed bearing stiffness and damping) as JSON.
+#[pyfunction]
+fn default_compliant_joints() -> PyResult<String> {
+    serde_json::to_string(&default_joints())
+        .map_err(|e| crate::python::parameter_error(format!("cannot write joints: {e}")))
+}
+
 /// Mass properties and generalised masses the model uses for a scene (SI).
 #[pyfunction]
 fn scene_model_info<'py>(py: Python<'py>, json: &str) -> PyResult<Bound<'py, PyDict>> {
-    let model = RigidModel::new(&scene(json)?)?;
+    let sc = scene(json)?;
+    let dof = match sc.joints {
+        Joints::Rigid => None,
+        Joints::Compliant { .. } => Some(CompliantModel::new(&sc)?.dof()),
+    };
+    let mut rigid = sc.clone();
+    rigid.joints = Joints::Rigid;
+    let model = RigidModel::new(&rigid)?;
     let d = PyDict::new(py);
     let i = model.inertias;
-    for (name, mp) in [("sun", i.sun), ("crank", i.crank), ("disc", i.disc), ("carrier", i.carrier)] {
+    for (name, mp) in [
+        ("sun", i.sun),
+        ("crank", i.crank),
+        ("disc", i.disc),
+        ("carrier", i.carrier),
+    ] {
         d.set_item(format!("{name}_mass"), mp.mass)?;
         d.set_item(format!("{name}_inertia"), mp.inertia)?;
     }
@@ -57,7 +78,8 @@ fn scene_model_info<'py>(py: Python<'py>, json: &str) -> PyResult<Bound<'py, PyD
     d.set_item("crank_radius", model.crank_radius)?;
     d.set_item("ratio", model.ratio)?;
     d.set_item("max_penetration", model.max_penetration)?;
-    d.set_item("dof", model.free.len())?;
+    d.set_item("dof", dof.unwrap_or(model.free.len()))?;
+    d.set_item("joints", if dof.is_some() { "compliant" } else { "rigid" })?;
     Ok(d)
 }
 
@@ -91,14 +113,20 @@ fn options(
         o.max_samples = v;
     }
     if let Some(ch) = channels {
-        o.channels = ch.iter().map(|c| Channel::parse(c)).collect::<Result<_, _>>()?;
+        o.channels = ch
+            .iter()
+            .map(|c| Channel::parse(c))
+            .collect::<Result<_, _>>()?;
     }
     o.skip_separated = skip_separated;
     Ok(o)
 }
 
 /// Recorded series as numpy arrays (first axis = samples), plus the run statistics.
-fn to_python<'py>(py: Python<'py>, rec: Recording) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+fn to_python<'py>(
+    py: Python<'py>,
+    rec: Recording,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
     let arrays = PyDict::new(py);
     let n = rec.samples;
     for (name, s) in rec.series {
@@ -138,7 +166,18 @@ fn simulate<'py>(
     skip_separated: bool,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
     let sc = scene(scene_json)?;
-    let opt = options(t_end, integrator, dt, rtol, atol, rho_inf, record_interval, max_samples, channels, skip_separated)?;
+    let opt = options(
+        t_end,
+        integrator,
+        dt,
+        rtol,
+        atol,
+        rho_inf,
+        record_interval,
+        max_samples,
+        channels,
+        skip_separated,
+    )?;
     let control = RunControl::default();
     let start = Instant::now();
     let outcome = std::thread::scope(|s| -> PyResult<Result<Recording, RvdynError>> {
@@ -172,7 +211,9 @@ fn simulate<'py>(
             eprintln!();
         }
         worker.join().map_err(|_| {
-            pyo3::exceptions::PyRuntimeError::new_err("the simulation thread panicked (a bug: please report it)")
+            pyo3::exceptions::PyRuntimeError::new_err(
+                "the simulation thread panicked (a bug: please report it)",
+            )
         })
     })?;
     let mut rec = outcome?;
@@ -217,12 +258,28 @@ fn sweep<'py>(
     threads: Option<usize>,
     skip_separated: bool,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let opt = options(t_end, integrator, dt, rtol, atol, rho_inf, record_interval, max_samples, channels, skip_separated)?;
-    let scenes: Vec<Scene> = scene_jsons.iter().map(|j| scene(j)).collect::<PyResult<_>>()?;
+    let opt = options(
+        t_end,
+        integrator,
+        dt,
+        rtol,
+        atol,
+        rho_inf,
+        record_interval,
+        max_samples,
+        channels,
+        skip_separated,
+    )?;
+    let scenes: Vec<Scene> = scene_jsons
+        .iter()
+        .map(|j| scene(j))
+        .collect::<PyResult<_>>()?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
-        .map_err(|e| crate::python::parameter_error(format!("cannot start {threads:?} threads: {e}")))?;
+        .map_err(|e| {
+            crate::python::parameter_error(format!("cannot start {threads:?} threads: {e}"))
+        })?;
     let results: Vec<(Result<Recording, RvdynError>, f64)> = py.detach(|| {
         pool.install(|| {
             scenes
@@ -243,7 +300,10 @@ fn sweep<'py>(
                 let (a, s) = to_python(py, rec)?;
                 Ok((a, s).into_pyobject(py)?.into_any())
             }
-            Err(e) => Ok(super::errors::to_pyerr(py, e).into_value(py).into_bound(py).into_any()),
+            Err(e) => Ok(super::errors::to_pyerr(py, e)
+                .into_value(py)
+                .into_bound(py)
+                .into_any()),
         })
         .collect()
 }
@@ -254,6 +314,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene_to_toml, m)?)?;
     m.add_function(wrap_pyfunction!(scene_from_toml, m)?)?;
     m.add_function(wrap_pyfunction!(scene_model_info, m)?)?;
+    m.add_function(wrap_pyfunction!(default_compliant_joints, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     Ok(())

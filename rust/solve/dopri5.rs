@@ -191,6 +191,8 @@ impl Dopri5 {
         }
     }
 
+    // Index loops over several parallel arrays read more plainly than zipped iterators here.
+    #[allow(clippy::needless_range_loop)]
     fn error_norm(&self, st: &State, h: f64, scale: &[f64]) -> f64 {
         let n = st.q.len();
         let mut sum = 0.0;

@@ -15,6 +15,7 @@ pub struct Rk4 {
 
 impl Rk4 {
     /// Advance `st` by `h` [s].
+    #[allow(clippy::needless_range_loop)]
     pub fn step<S: MechanicalSystem>(&mut self, sys: &S, st: &mut State, h: f64) -> Result<()> {
         let n = st.q.len();
         for k in 0..4 {

@@ -1,0 +1,104 @@
+"""rvdyn: dynamics of RV cycloid planetary reducers, with a Rust core.
+
+Units are SI everywhere (m, kg, s, N, rad, Pa; IMPACT stiffness in N/m^exponent). Degrees per
+second appear only in the command-line output and through :func:`deg_s` / :func:`rad_s`.
+
+Main entry points
+-----------------
+CycloidGeometry
+    Exact cycloid disc: profile, normals, curvature, exact pin gap, mass properties.
+InvoluteStage
+    The involute first stage (sun and planets).
+contact_stiffness, stiffness_maximum, hertz_line_contact, impact_force
+    Contact laws (vectorised, numpy in and out).
+transmission_ratio, body_speeds, operating_point
+    Kinematics and the operating point.
+Scene, simulate, sweep, Result
+    Reducer scenes, dynamic runs (one or many in parallel) and their recorded results.
+rvdyn.plotting
+    Matplotlib figures (geometry, contact stiffness).
+"""
+
+from __future__ import annotations
+
+import math
+
+from . import _core
+from ._core import (
+    PAPER_IMPACT_DEPTH,
+    PAPER_IMPACT_EXPONENT,
+    PAPER_IMPACT_MAX_DAMPING,
+    PAPER_IMPACT_STIFFNESS,
+    PAPER_PRINTED_OUTPUT_TORQUE,
+    PAPER_STIFFNESS_R1,
+    PAPER_STIFFNESS_R2,
+    CycloidGeometry,
+    InvoluteStage,
+    body_speeds,
+    contact_stiffness,
+    hertz_line_contact,
+    impact_force,
+    operating_point,
+    stiffness_maximum,
+    transmission_ratio,
+)
+from ._types import GapResult, LineContact, OperatingPoint
+from .result import Result
+from .scene import Scene
+from .simulation import INTEGRATORS, simulate, sweep
+from .errors import (
+    ConvergenceError,
+    GeometryError,
+    ParameterError,
+    RvdynError,
+    SceneError,
+    SimulationError,
+)
+
+__version__: str = _core.__version__
+
+__all__ = [
+    "__version__",
+    "Scene",
+    "Result",
+    "simulate",
+    "sweep",
+    "INTEGRATORS",
+    "CycloidGeometry",
+    "InvoluteStage",
+    "GapResult",
+    "LineContact",
+    "OperatingPoint",
+    "contact_stiffness",
+    "stiffness_maximum",
+    "hertz_line_contact",
+    "impact_force",
+    "transmission_ratio",
+    "body_speeds",
+    "operating_point",
+    "deg_s",
+    "rad_s",
+    "PAPER_IMPACT_STIFFNESS",
+    "PAPER_IMPACT_EXPONENT",
+    "PAPER_IMPACT_MAX_DAMPING",
+    "PAPER_IMPACT_DEPTH",
+    "PAPER_PRINTED_OUTPUT_TORQUE",
+    "PAPER_STIFFNESS_R1",
+    "PAPER_STIFFNESS_R2",
+    "RvdynError",
+    "GeometryError",
+    "ParameterError",
+    "SceneError",
+    "ConvergenceError",
+    "SimulationError",
+]
+
+
+def deg_s(rad_per_s: float) -> float:
+    """Convert an angular speed from rad/s to deg/s (e.g. for comparing with the paper)."""
+    return float(rad_per_s) * 180.0 / math.pi
+
+
+def rad_s(deg_per_s: float) -> float:
+    """Convert an angular speed from deg/s to rad/s (the paper's 8328 deg/s -> 145.35 rad/s)."""
+    return float(deg_per_s) * math.pi / 180.0

@@ -1,0 +1,328 @@
+"""Type stubs of the compiled core ``rvdyn._core`` (hand-written; keep in sync with rust/python/).
+
+Units are SI: m, kg, s, N, rad, Pa; IMPACT stiffness in N/m^exponent. Array arguments accept a
+float, a sequence or a numpy array; functions marked "broadcast" combine their array arguments
+with numpy's broadcasting rules and return a float when every array argument is a scalar.
+"""
+
+from typing import Any, Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._types import GapResult, LineContact, OperatingPoint
+
+_FloatOrArray = Union[float, NDArray[np.float64]]
+
+__version__: str
+
+PAPER_IMPACT_STIFFNESS: float
+"""The paper's IMPACT stiffness 3.988e5 N/mm^1.5 in SI: 1.2611e10 N/m^1.5."""
+PAPER_IMPACT_EXPONENT: float
+"""The paper's IMPACT force exponent: 1.5."""
+PAPER_IMPACT_MAX_DAMPING: float
+"""The paper's IMPACT maximum damping 100 N s/mm in SI: 1e5 N s/m."""
+PAPER_IMPACT_DEPTH: float
+"""The paper's IMPACT penetration depth for full damping 0.01 mm in SI: 1e-5 m."""
+PAPER_STIFFNESS_R1: float
+"""Pin radius R1 [m] used to read the paper's Fig. 3 (assumed 10 mm)."""
+PAPER_STIFFNESS_R2: float
+"""Disc radius R2 [m] used to read the paper's Fig. 3 (disc pitch radius e zc = 103.5 mm)."""
+PAPER_PRINTED_OUTPUT_TORQUE: float
+"""The output torque printed in the paper, 4024.9 N m: inconsistent with its 112 kW (it is
+10.3 kW at the output speed); the lossless value is 43.92 kN m."""
+
+class CycloidGeometry:
+    """A validated cycloid disc and its pin ring (SI units: m, rad).
+
+    Parameters: pins zp (>= 3), eccentricity e [m], pin_circle_radius rp [m], pin_radius
+    rrp [m], face_width [m], d_rp and d_rrp shift and equidistant modifications [m] (grinding
+    convention, the pins stay at rp with radius rrp), d_delta rotation modification [rad].
+
+    Raises GeometryError naming the rule (fewer than 3 pins, curtate ratio K1 >= 1, overlapping
+    pins, undercut, no material at the root) and ParameterError for non-finite or
+    non-positive sizes.
+    """
+
+    def __init__(
+        self,
+        pins: int,
+        eccentricity: float,
+        pin_circle_radius: float,
+        pin_radius: float,
+        face_width: float,
+        d_rp: float = 0.0,
+        d_rrp: float = 0.0,
+        d_delta: float = 0.0,
+    ) -> None: ...
+    @classmethod
+    def paper(cls) -> CycloidGeometry:
+        """The paper's default disc: zp 24, e 4.5 mm (given); rp 150 mm, rrp 10 mm, face 40 mm
+        (assumed); no modification."""
+    @property
+    def pins(self) -> int:
+        """Number of pins zp."""
+    @property
+    def lobes(self) -> int:
+        """Number of lobes zc = zp - 1."""
+    @property
+    def eccentricity(self) -> float:
+        """Eccentricity e [m]."""
+    @property
+    def pin_circle_radius(self) -> float:
+        """Pin circle radius rp [m]."""
+    @property
+    def pin_radius(self) -> float:
+        """Pin radius rrp [m]."""
+    @property
+    def face_width(self) -> float:
+        """Disc face width [m]."""
+    @property
+    def d_rp(self) -> float:
+        """Shift modification d_rp [m]."""
+    @property
+    def d_rrp(self) -> float:
+        """Equidistant modification d_rrp [m]."""
+    @property
+    def d_delta(self) -> float:
+        """Rotation modification d_delta [rad]."""
+    @property
+    def k1(self) -> float:
+        """Curtate ratio K1 = e zp / (rp + d_rp) [-]."""
+    @property
+    def pitch_radius(self) -> float:
+        """Disc pitch radius rc' = e zc [m]."""
+    @property
+    def min_convex_radius(self) -> float:
+        """Minimum convex radius of curvature of the pin-centre curve [m] (undercut limit)."""
+    def profile(self, phi: ArrayLike) -> NDArray[np.float64]:
+        """Profile points (x, y) [m], disc frame, for curve parameters phi [rad] of any shape;
+        returns shape phi.shape + (2,)."""
+    def normal(self, phi: ArrayLike) -> NDArray[np.float64]:
+        """Outward unit normals of the profile, disc frame; shape phi.shape + (2,)."""
+    def curvature_radius(self, phi: ArrayLike) -> _FloatOrArray:
+        """Signed radius of curvature of the profile [m] (positive convex); shape phi.shape,
+        a float for a scalar phi."""
+    def gap(
+        self,
+        pin_center: ArrayLike,
+        disc_center: ArrayLike,
+        disc_angle: float,
+        pin_radius: float | None = None,
+    ) -> GapResult:
+        """Exact signed gap between a pin (centre (2,) [m]) and the disc placed at disc_center
+        (2,) [m] turned by disc_angle [rad], fixed frame. pin_radius [m] overrides the disc's
+        pin radius. Raises ParameterError (bad input) or ConvergenceError (no unique nearest
+        point)."""
+    def pin_positions(self) -> NDArray[np.float64]:
+        """Pin centres (zp, 2) [m]; row j is at angle 2 pi j / zp, the paper's pin j + 1."""
+    def kinematic_pose(self, psi: float) -> tuple[NDArray[np.float64], float]:
+        """Disc centre (2,) [m] = e (cos psi, sin psi) and disc angle -psi/zc [rad] for the
+        crank angle psi [rad]."""
+    def mass_properties(self, density: float = 7850.0) -> tuple[float, float]:
+        """(mass [kg], polar inertia about the disc centre [kg m^2]) of the disc with the
+        default holes, for a density [kg/m^3]."""
+    def __reduce__(self) -> tuple[Any, ...]: ...
+
+class InvoluteStage:
+    """The involute first stage (sun and equally spaced planets; SI units).
+
+    Parameters: z_sun, z_planet (>= 5 teeth), planets (>= 1), module [m], pressure_angle [rad]
+    in (0, 45 deg), face_width [m], backlash [m] along the line of action (>= 0).
+
+    Raises GeometryError (too few teeth, colliding planets, contact ratio < 1) and
+    ParameterError (non-finite or non-positive sizes, pressure angle out of range).
+    """
+
+    def __init__(
+        self,
+        z_sun: int,
+        z_planet: int,
+        planets: int,
+        module: float,
+        pressure_angle: float,
+        face_width: float,
+        backlash: float = 0.0,
+    ) -> None: ...
+    @classmethod
+    def paper(cls) -> InvoluteStage:
+        """The paper's stage: 18/42 teeth, 3 planets (given); module 3 mm, 20 deg, face 30 mm
+        (assumed)."""
+    @property
+    def z_sun(self) -> int:
+        """Sun teeth."""
+    @property
+    def z_planet(self) -> int:
+        """Teeth of each planet."""
+    @property
+    def planets(self) -> int:
+        """Number of planets."""
+    @property
+    def module(self) -> float:
+        """Module [m]."""
+    @property
+    def pressure_angle(self) -> float:
+        """Pressure angle [rad]."""
+    @property
+    def face_width(self) -> float:
+        """Face width [m]."""
+    @property
+    def backlash(self) -> float:
+        """Total backlash of one mesh along the line of action [m]."""
+    @property
+    def sun_pitch_radius(self) -> float:
+        """Sun pitch radius [m]."""
+    @property
+    def planet_pitch_radius(self) -> float:
+        """Planet pitch radius [m]."""
+    @property
+    def sun_base_radius(self) -> float:
+        """Sun base radius [m]."""
+    @property
+    def planet_base_radius(self) -> float:
+        """Planet base radius [m]."""
+    @property
+    def centre_distance(self) -> float:
+        """Centre distance = crank circle radius [m]."""
+    @property
+    def addendum(self) -> float:
+        """Addendum (= module) [m]."""
+    @property
+    def sun_tip_radius(self) -> float:
+        """Sun tip radius [m]."""
+    @property
+    def planet_tip_radius(self) -> float:
+        """Planet tip radius [m]."""
+    @property
+    def line_of_action_length(self) -> float:
+        """Length of the path of contact [m]."""
+    @property
+    def contact_ratio(self) -> float:
+        """Transverse contact ratio [-]."""
+    @property
+    def stage_ratio(self) -> float:
+        """Fixed-carrier stage ratio -z_planet / z_sun [-]."""
+    @property
+    def planet_angles(self) -> NDArray[np.float64]:
+        """Planet centre angles (planets,) [rad], carrier frame, planet 0 on +x."""
+    def __reduce__(self) -> tuple[Any, ...]: ...
+
+def contact_stiffness(
+    width: ArrayLike,
+    r1: ArrayLike,
+    r2: ArrayLike,
+    condition: str = "convex-convex",
+    youngs_modulus: float = 2.17e11,
+    poisson_ratio: float = 0.3,
+    exponent: float = 1.5,
+    penetration: float = 1e-5,
+) -> _FloatOrArray:
+    """Paper's contact stiffness k [N/m^exponent] (eqs. 5-11, errata corrected) for contact
+    width [m], pin radius r1 [m] and disc radius of curvature r2 [m] (broadcast); condition
+    "convex-convex" or "convex-concave"; E [Pa], nu [-], IMPACT exponent [-] and penetration
+    depth x [m]."""
+
+def stiffness_maximum(
+    r1: float,
+    r2: float,
+    condition: str = "convex-convex",
+    lo: float = 1e-4,
+    hi: float = 0.1,
+    youngs_modulus: float = 2.17e11,
+    poisson_ratio: float = 0.3,
+    exponent: float = 1.5,
+    penetration: float = 1e-5,
+) -> tuple[float, float]:
+    """(width [m], k_max [N/m^exponent]) of the largest stiffness for widths in [lo, hi] [m];
+    ParameterError if there is no interior maximum (the case for physical widths with the
+    corrected formulas)."""
+
+def hertz_line_contact(
+    force: ArrayLike,
+    width: ArrayLike,
+    r1: ArrayLike,
+    r2: ArrayLike,
+    youngs_modulus: float = 2.17e11,
+    poisson_ratio: float = 0.3,
+) -> LineContact:
+    """Hertz line contact for force [N] over width [m] between radii r1, r2 [m] (positive
+    convex, negative concave), broadcast: half_width [m], peak_pressure [Pa], mean_pressure
+    [Pa], approach [m]."""
+
+def impact_force(
+    penetration: ArrayLike,
+    velocity: ArrayLike,
+    k: float,
+    exponent: float = 1.5,
+    cmax: float = 1.0e5,
+    depth: float = 1.0e-5,
+) -> _FloatOrArray:
+    """ADAMS IMPACT force [N] >= 0 for penetration [m] and penetration rate [m/s] (broadcast),
+    stiffness k [N/m^exponent], exponent [-], cmax [N s/m], depth [m]."""
+
+def transmission_ratio(z_sun: int, z_planet: int, pins: int) -> float:
+    """Overall ratio 1 + (z_planet / z_sun) pins [-] (57 for the paper)."""
+
+def body_speeds(
+    input_speed: float, z_sun: int = 18, z_planet: int = 42, pins: int = 24
+) -> dict[str, float]:
+    """Speeds [rad/s] of sun, crank_absolute, crank_relative, disc_spin, disc_orbit, carrier
+    for an input speed [rad/s]."""
+
+def operating_point(power: float, input_speed: float, ratio: float) -> OperatingPoint:
+    """Lossless operating point for power [W], input speed [rad/s] and ratio [-]."""
+
+# ---- scenes and dynamic runs (rust/python/simulate.rs; wrapped by rvdyn.Scene, rvdyn.simulate,
+# rvdyn.sweep and rvdyn.Result: use those) ----------------------------------------------------
+
+def scene_paper(load: str) -> str:
+    """The default scene as JSON; load is "idle", "paper" or "rated"."""
+
+def scene_validate(json: str) -> str:
+    """Validate a scene given as JSON; returns it normalised (defaults filled in) as JSON."""
+
+def scene_to_toml(json: str) -> str:
+    """Scene JSON -> TOML text."""
+
+def scene_from_toml(text: str) -> str:
+    """TOML text -> validated scene JSON."""
+
+def scene_model_info(json: str) -> dict[str, Any]:
+    """Mass properties [kg, kg m^2] and generalised masses the model uses for a scene (SI),
+    crank radius [m], ratio, number of free coordinates (dof) and joint kind."""
+
+def default_compliant_joints() -> str:
+    """The default compliant joints (assumed bearing stiffness [N/m] and damping [N s/m]) as JSON."""
+
+def simulate(
+    scene_json: str,
+    t_end: float,
+    integrator: str,
+    dt: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    rho_inf: float | None = None,
+    record_interval: float | None = None,
+    max_samples: int | None = None,
+    channels: list[str] | None = None,
+    progress: bool = False,
+    skip_separated: bool = True,
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Run one scene for t_end [s]; returns (recorded numpy arrays, run statistics).
+    skip_separated: do not query pins that provably cannot touch (same answer, less work)."""
+
+def sweep(
+    scene_jsons: list[str],
+    t_end: float,
+    integrator: str,
+    dt: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    rho_inf: float | None = None,
+    record_interval: float | None = None,
+    max_samples: int | None = None,
+    channels: list[str] | None = None,
+    threads: int | None = None,
+    skip_separated: bool = True,
+) -> list[tuple[dict[str, Any], dict[str, Any]] | BaseException]:
+    """Run many scenes in parallel; per scene (arrays, statistics) or the exception it raised."""

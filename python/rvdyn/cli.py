@@ -1,0 +1,373 @@
+"""The ``rvdyn`` command line.
+
+Subcommands::
+
+    rvdyn info [--json]                     kinematics, operating point, geometry, stiffness
+    rvdyn plot-geometry [--out DIR] [--psi RAD]
+    rvdyn plot-stiffness [--out DIR]
+    rvdyn paper [--out DIR] [--t-end S] [--load {idle,paper,rated,all}] [--integrator NAME]
+
+Each subcommand is one entry of :data:`COMMANDS` (name, help, arguments, handler): to add a
+subcommand, write ``_add_x(parser)`` and ``_run_x(args) -> int`` and append one
+:class:`Command`. Speeds are printed in deg/s and rad/s (the paper uses deg/s); everything else
+is SI.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import math
+import os
+import sys
+from dataclasses import dataclass
+from typing import Any, Callable, Sequence
+
+__all__ = ["main", "build_parser", "info_data", "COMMANDS", "Command"]
+
+#: The paper's input speed [deg/s] and power [W] (section 4.1).
+PAPER_INPUT_SPEED_DEG_S = 8328.0
+PAPER_POWER_W = 112e3
+DEFAULT_OUT = "rvdyn-out"
+
+
+@dataclass(frozen=True)
+class Command:
+    """One subcommand: its name, one-line help, argument adder and handler (returns exit code)."""
+
+    name: str
+    help: str
+    add_arguments: Callable[[argparse.ArgumentParser], None]
+    run: Callable[[argparse.Namespace], int]
+
+
+# ---------------------------------------------------------------------------------------------
+# info
+
+
+def info_data() -> dict[str, Any]:
+    """Everything ``rvdyn info`` prints, as a JSON-ready dict (SI units; speeds also in deg/s)."""
+    import rvdyn
+
+    z_sun, z_planet, pins = 18, 42, 24
+    ratio = rvdyn.transmission_ratio(z_sun, z_planet, pins)
+    w_in = rvdyn.rad_s(PAPER_INPUT_SPEED_DEG_S)
+    speeds = rvdyn.body_speeds(w_in, z_sun, z_planet, pins)
+    op = rvdyn.operating_point(PAPER_POWER_W, w_in, ratio)
+    printed = rvdyn.PAPER_PRINTED_OUTPUT_TORQUE
+    printed_power = printed * op.output_speed
+
+    g = rvdyn.CycloidGeometry.paper()
+    stage = rvdyn.InvoluteStage.paper()
+    mass, inertia = g.mass_properties()
+
+    r1, r2 = rvdyn.PAPER_STIFFNESS_R1, rvdyn.PAPER_STIFFNESS_R2
+    paper_max = {"convex-convex": 3.988e5, "convex-concave": 5.093e5}
+    stiffness: dict[str, Any] = {
+        "r1_m": r1,
+        "r2_m": r2,
+        "radii_note": (
+            "R1 = pin radius (assumed 10 mm), R2 = disc pitch radius e*zc = 103.5 mm "
+            "(the paper gives no radii for its Fig. 3)"
+        ),
+        "exponent": 1.5,
+        "conditions": {},
+    }
+    lo, hi = 1e-4, 0.1
+    for cond, paper_value in paper_max.items():
+        k5 = float(rvdyn.contact_stiffness(5e-3, r1, r2, cond))
+        entry: dict[str, Any] = {
+            "k_at_5mm_N_per_m1_5": k5,
+            "k_at_5mm_N_per_mm1_5": k5 / 1000.0**1.5,
+            "paper_maximum_N_per_mm1_5": paper_value,
+            "paper_maximum_width_m": 5e-3,
+            "search_bracket_m": [lo, hi],
+        }
+        try:
+            w_max, k_max = rvdyn.stiffness_maximum(r1, r2, cond, lo=lo, hi=hi)
+            entry["maximum"] = {"width_m": w_max, "k_N_per_m1_5": k_max}
+        except rvdyn.ParameterError as exc:
+            entry["maximum"] = None
+            entry["maximum_note"] = str(exc)
+        try:
+            w_f, k_f = rvdyn.stiffness_maximum(r1, r2, cond, lo=1e-8, hi=1e-6)
+            entry["formal_maximum"] = {
+                "width_m": w_f,
+                "k_N_per_m1_5": k_f,
+                "note": "outside Hertz theory: the contact width b is far larger than the radii",
+            }
+        except rvdyn.ParameterError:
+            entry["formal_maximum"] = None
+        stiffness["conditions"][cond] = entry
+
+    return {
+        "scene": "paper (default): z1 18, z2 42, 3 planets, zp 24, e 4.5 mm given; "
+        "rp 150 mm, rrp 10 mm, disc 40 mm, module 3 mm, 20 deg, gear face 30 mm assumed",
+        "kinematics": {
+            "z_sun": z_sun,
+            "z_planet": z_planet,
+            "pins": pins,
+            "lobes": pins - 1,
+            "ratio": ratio,
+            "input_speed_deg_s": PAPER_INPUT_SPEED_DEG_S,
+            "speeds": {
+                name: {"rad_s": value, "deg_s": rvdyn.deg_s(value)}
+                for name, value in speeds.items()
+            },
+        },
+        "operating_point": {
+            "power_W": op.power,
+            "input_speed_rad_s": op.input_speed,
+            "output_speed_rad_s": op.output_speed,
+            "input_torque_Nm": op.input_torque,
+            "output_torque_Nm": op.output_torque,
+            "paper_printed_output_torque_Nm": printed,
+            "paper_printed_output_power_W": printed_power,
+            "paper_printed_output_torque_consistent": bool(
+                math.isclose(printed, op.output_torque, rel_tol=0.01)
+            ),
+            "note": (
+                f"the paper's printed output torque {printed} N m is only "
+                f"{printed_power / 1e3:.1f} kW at the output speed; 112 kW gives "
+                f"{op.output_torque / 1e3:.2f} kN m (lossless, = ratio x input torque)"
+            ),
+        },
+        "geometry": {
+            "cycloid": {
+                "pins": g.pins,
+                "lobes": g.lobes,
+                "eccentricity_m": g.eccentricity,
+                "pin_circle_radius_m": g.pin_circle_radius,
+                "pin_radius_m": g.pin_radius,
+                "face_width_m": g.face_width,
+                "k1": g.k1,
+                "min_convex_radius_m": g.min_convex_radius,
+                "pitch_radius_m": g.pitch_radius,
+                "root_curvature_radius_m": float(g.curvature_radius(0.0)),
+                "disc_mass_kg": mass,
+                "disc_inertia_kg_m2": inertia,
+            },
+            "involute": {
+                "z_sun": stage.z_sun,
+                "z_planet": stage.z_planet,
+                "planets": stage.planets,
+                "module_m": stage.module,
+                "pressure_angle_rad": stage.pressure_angle,
+                "face_width_m": stage.face_width,
+                "centre_distance_m": stage.centre_distance,
+                "contact_ratio": stage.contact_ratio,
+            },
+        },
+        "stiffness": stiffness,
+    }
+
+
+def _format_info(d: dict[str, Any]) -> str:
+    kin, op, geo, st = d["kinematics"], d["operating_point"], d["geometry"], d["stiffness"]
+    cyc, inv = geo["cycloid"], geo["involute"]
+    lines = [
+        "rvdyn: default scene ('paper')",
+        f"  {d['scene']}",
+        "",
+        "Kinematics",
+        f"  ratio i = 1 + (z2/z1) zp = 1 + ({kin['z_planet']}/{kin['z_sun']}) {kin['pins']}"
+        f" = {kin['ratio']:g}",
+        f"  speeds for input {kin['input_speed_deg_s']:g} deg/s (counter-clockwise positive):",
+    ]
+    for name, v in kin["speeds"].items():
+        lines.append(f"    {name:15s} {v['deg_s']:12.3f} deg/s  {v['rad_s']:12.5f} rad/s")
+    lines += [
+        "",
+        "Operating point (lossless)",
+        f"  power          {op['power_W'] / 1e3:10.1f} kW",
+        f"  input torque   {op['input_torque_Nm']:10.2f} N m",
+        f"  output torque  {op['output_torque_Nm'] / 1e3:10.2f} kN m",
+        f"  paper's printed output torque {op['paper_printed_output_torque_Nm']} N m: "
+        + ("consistent" if op["paper_printed_output_torque_consistent"] else "INCONSISTENT"),
+        f"    ({op['note']})",
+        "",
+        "Geometry",
+        f"  cycloid: zp {cyc['pins']}, zc {cyc['lobes']}, e {cyc['eccentricity_m'] * 1e3:g} mm, "
+        f"rp {cyc['pin_circle_radius_m'] * 1e3:g} mm, rrp {cyc['pin_radius_m'] * 1e3:g} mm, "
+        f"face {cyc['face_width_m'] * 1e3:g} mm",
+        f"    K1 = {cyc['k1']:.4f}, pitch radius rc' = {cyc['pitch_radius_m'] * 1e3:.2f} mm, "
+        f"min convex radius {cyc['min_convex_radius_m'] * 1e3:.3f} mm, "
+        f"root radius of curvature {cyc['root_curvature_radius_m'] * 1e3:.3f} mm",
+        f"    disc mass {cyc['disc_mass_kg']:.3f} kg, inertia {cyc['disc_inertia_kg_m2']:.4f} "
+        "kg m^2 (steel, with bore and holes)",
+        f"  involute stage: {inv['z_sun']}/{inv['z_planet']}, {inv['planets']} planets, "
+        f"module {inv['module_m'] * 1e3:g} mm, {math.degrees(inv['pressure_angle_rad']):g} deg, "
+        f"centre distance {inv['centre_distance_m'] * 1e3:g} mm, "
+        f"contact ratio {inv['contact_ratio']:.3f}",
+        "",
+        f"Contact stiffness (eqs. 5-11, errata corrected), R1 = {st['r1_m'] * 1e3:g} mm, "
+        f"R2 = {st['r2_m'] * 1e3:g} mm",
+        f"  ({st['radii_note']})",
+    ]
+    for cond, e in st["conditions"].items():
+        lines.append(
+            f"  {cond}: k(5 mm) = {e['k_at_5mm_N_per_m1_5']:.4e} N/m^1.5 "
+            f"= {e['k_at_5mm_N_per_mm1_5']:.4e} N/mm^1.5 "
+            f"(paper's maximum {e['paper_maximum_N_per_mm1_5']:.4g} N/mm^1.5 near 5 mm)"
+        )
+        lo, hi = e["search_bracket_m"]
+        if e["maximum"] is not None:
+            m = e["maximum"]
+            lines.append(
+                f"    maximum {m['k_N_per_m1_5']:.4e} N/m^1.5 at width {m['width_m'] * 1e3:.3f} mm"
+            )
+        else:
+            lines.append(
+                f"    no maximum for widths {lo * 1e3:g}-{hi * 1e3:g} mm: k decreases with width"
+            )
+        if e["formal_maximum"] is not None:
+            f = e["formal_maximum"]
+            lines.append(
+                f"    formal maximum {f['k_N_per_m1_5']:.4e} N/m^1.5 at width "
+                f"{f['width_m'] * 1e3:.3g} mm ({f['note']})"
+            )
+    return "\n".join(lines)
+
+
+def _add_info(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--json", action="store_true", help="print JSON (SI units) instead of text")
+
+
+def _run_info(args: argparse.Namespace) -> int:
+    data = info_data()
+    if args.json:
+        print(json.dumps(data, indent=2))
+    else:
+        print(_format_info(data))
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------
+# plots
+
+
+def _out_dir(path: str) -> str:
+    os.makedirs(path, exist_ok=True)
+    return path
+
+
+def _add_plot_geometry(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
+                   help=f"output folder (default {DEFAULT_OUT})")
+    p.add_argument("--psi", type=float, default=0.0, metavar="RAD",
+                   help="crank angle of the front disc [rad] (default 0)")
+    p.add_argument("--disc", choices=("both", "front", "rear"), default="both",
+                   help="which disc(s) to draw (default both)")
+
+
+def _run_plot_geometry(args: argparse.Namespace) -> int:
+    from .plotting import plot_geometry, save_figure
+
+    fig = plot_geometry(psi=args.psi, disc=args.disc)
+    path = save_figure(fig, os.path.join(_out_dir(args.out), "geometry.png"))
+    print(f"wrote {path}")
+    return 0
+
+
+def _add_plot_stiffness(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
+                   help=f"output folder (default {DEFAULT_OUT})")
+
+
+def _run_plot_stiffness(args: argparse.Namespace) -> int:
+    from .plotting import plot_stiffness, save_figure
+
+    fig = plot_stiffness()
+    path = save_figure(fig, os.path.join(_out_dir(args.out), "stiffness.png"))
+    print(f"wrote {path}")
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------
+# paper (implemented in rvdyn.paper when present)
+
+
+def _add_paper(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
+                   help=f"output folder (default {DEFAULT_OUT})")
+    p.add_argument("--t-end", type=float, default=5.0, metavar="SECONDS",
+                   help="simulated time [s] (default 5.0)")
+    p.add_argument("--load", choices=("idle", "paper", "rated", "all"), default="all",
+                   help="load case: idle, paper (4024.9 N m as printed), rated (43.9 kN m), "
+                   "or all (default)")
+    try:
+        from .simulation import INTEGRATORS
+    except ImportError:  # pragma: no cover - a build without the simulation module
+        INTEGRATORS = None
+    p.add_argument("--integrator", default=None, metavar="NAME", choices=INTEGRATORS,
+                   help="time integrator"
+                   + (f": one of {', '.join(INTEGRATORS)}" if INTEGRATORS else "")
+                   + " (default: the library's choice)")
+
+
+def _run_paper(args: argparse.Namespace) -> int:
+    try:
+        paper = importlib.import_module("rvdyn.paper")
+    except ModuleNotFoundError as exc:
+        if exc.name != "rvdyn.paper":
+            raise
+        print("rvdyn paper: not available in this version (module rvdyn.paper is missing)",
+              file=sys.stderr)
+        return 2
+    result = paper.main(args)
+    return int(result) if result is not None else 0
+
+
+COMMANDS: list[Command] = [
+    Command("info", "print the default scene's kinematics, loads, geometry and stiffness",
+            _add_info, _run_info),
+    Command("plot-geometry", "draw the discs and pins (PNG)", _add_plot_geometry,
+            _run_plot_geometry),
+    Command("plot-stiffness", "draw contact stiffness vs contact width (PNG, paper Fig. 3)",
+            _add_plot_stiffness, _run_plot_stiffness),
+    Command("paper", "run the paper's simulations on the default scene and write figures",
+            _add_paper, _run_paper),
+]
+
+
+def build_parser(commands: Sequence[Command] = COMMANDS) -> argparse.ArgumentParser:
+    """The argument parser with one subparser per :class:`Command`."""
+    from . import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="rvdyn",
+        description="Dynamics of RV cycloid planetary reducers (SI units; speeds also in deg/s).",
+    )
+    parser.add_argument("--version", action="version", version=f"rvdyn {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for cmd in commands:
+        p = sub.add_parser(cmd.name, help=cmd.help, description=cmd.help)
+        cmd.add_arguments(p)
+        p.set_defaults(_run=cmd.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``rvdyn`` console script; returns the exit code."""
+    from .errors import RvdynError
+
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args._run(args))
+    except RvdynError as exc:
+        print(f"rvdyn {args.command}: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"rvdyn {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # Output piped into e.g. `head`: stop quietly, as Unix tools do.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

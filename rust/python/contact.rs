@@ -1,0 +1,324 @@
+//! Bindings of the contact core: the paper's contact stiffness, Hertz line contact, the IMPACT
+//! law. Array arguments broadcast together (numpy rules); scalar-only calls return floats.
+
+use super::{Broadcast, FloatArray, Input, output, python_type, with_context};
+use crate::contact::hertz::{Material, hertz_line_contact as core_hertz};
+use crate::contact::impact::ImpactLaw;
+use crate::contact::stiffness::{
+    ContactCondition, StiffnessParams, contact_stiffness as core_stiffness,
+    stiffness_maximum as core_maximum,
+};
+use crate::error::RvdynError;
+use pyo3::prelude::*;
+
+/// Run `f` on every broadcast element with the GIL released; the first error is returned with
+/// the element's flat index when there is more than one element.
+fn map_broadcast<const N: usize>(
+    py: Python<'_>,
+    b: &Broadcast,
+    f: impl Fn(&Broadcast, usize) -> Result<[f64; N], RvdynError> + Send + Sync,
+) -> PyResult<Vec<[f64; N]>> {
+    let out = py.detach(|| {
+        let mut out = Vec::with_capacity(b.len);
+        for i in 0..b.len {
+            match f(b, i) {
+                Ok(v) => out.push(v),
+                Err(e) if b.len > 1 => {
+                    return Err(with_context(e, &format!("at flat index {i} of the inputs")));
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        Ok(out)
+    })?;
+    Ok(out)
+}
+
+/// One output array per column of `rows`.
+fn columns<'py, const N: usize>(
+    py: Python<'py>,
+    shape: &[usize],
+    rows: Vec<[f64; N]>,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let mut cols: Vec<Vec<f64>> = (0..N).map(|_| Vec::with_capacity(rows.len())).collect();
+    for row in rows {
+        for (c, v) in cols.iter_mut().zip(row) {
+            c.push(v);
+        }
+    }
+    cols.into_iter().map(|c| output(py, shape, c)).collect()
+}
+
+/// The paper's stiffness parameters for radii `r1`, `r2` [m], one condition and one material
+/// for both bodies. Validated by the core when used.
+fn stiffness_params(
+    r1: f64,
+    r2: f64,
+    condition: ContactCondition,
+    material: Material,
+    exponent: f64,
+    penetration: f64,
+) -> StiffnessParams {
+    StiffnessParams {
+        r1,
+        r2,
+        condition,
+        material1: material,
+        material2: material,
+        exponent,
+        penetration,
+    }
+}
+
+/// Contact stiffness k of the paper's eqs. 5-11 (errata corrected) against contact width.
+///
+/// k = k' sqrt(w) with k' = (4/3) E* sqrt(R) (eq. 6), F = k' x^e (eq. 10), Roark's full Hertz
+/// width b = 1.60 sqrt(F/L K_D / E*) (eq. 11) and the approach w of eq. 9, evaluated in the
+/// paper's N-mm units and converted to SI (the paper's "N/mm^2" is N/mm^e, erratum 4).
+/// 1/E* = 2 (1 - nu^2)/E (both bodies of the same material; the paper's eq. 8 subtracts).
+///
+/// Parameters
+/// ----------
+/// width : float or array_like
+///     Contact width L (the face width in contact) [m].
+/// r1 : float or array_like
+///     Pin radius R1 [m].
+/// r2 : float or array_like
+///     Magnitude of the disc's radius of curvature at the contact R2 [m] (> r1 for
+///     convex-concave).
+/// condition : {"convex-convex", "convex-concave"}
+///     Pin on a lobe tip (R = R1 R2/(R1 + R2)) or in a root (R = R1 R2/(R2 - R1)).
+/// youngs_modulus : float
+///     Young's modulus E of both bodies [Pa] (paper: 2.17e11).
+/// poisson_ratio : float
+///     Poisson's ratio nu of both bodies [-] (paper: 0.3).
+/// exponent : float
+///     IMPACT force exponent e [-] (paper: 1.5).
+/// penetration : float
+///     IMPACT penetration depth x of eq. 10 [m] (paper: 0.01 mm = 1e-5 m).
+///
+/// Returns
+/// -------
+/// float or numpy.ndarray
+///     k [N/m^exponent], shape of the broadcast width, r1, r2 (a float if all are scalars).
+///
+/// Raises
+/// ------
+/// ParameterError
+///     Non-finite or non-positive inputs, unknown condition, shapes that do not broadcast.
+/// GeometryError
+///     Convex-concave contact with r2 <= r1.
+#[pyfunction]
+#[pyo3(signature = (width, r1, r2, condition="convex-convex", youngs_modulus=2.17e11, poisson_ratio=0.3, exponent=1.5, penetration=1e-5))]
+#[allow(clippy::too_many_arguments)]
+fn contact_stiffness<'py>(
+    py: Python<'py>,
+    width: FloatArray<'py>,
+    r1: FloatArray<'py>,
+    r2: FloatArray<'py>,
+    condition: &str,
+    youngs_modulus: f64,
+    poisson_ratio: f64,
+    exponent: f64,
+    penetration: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let condition = ContactCondition::parse(condition)?;
+    let material = Material::new(youngs_modulus, poisson_ratio)?;
+    let b = Broadcast::new(vec![
+        ("width", Input::finite("width", "m", &width)?),
+        ("r1", Input::finite("r1", "m", &r1)?),
+        ("r2", Input::finite("r2", "m", &r2)?),
+    ])?;
+    let rows = map_broadcast::<1>(py, &b, |b, i| {
+        let p = stiffness_params(
+            b.get(1, i),
+            b.get(2, i),
+            condition,
+            material,
+            exponent,
+            penetration,
+        );
+        Ok([core_stiffness(b.get(0, i), &p)?])
+    })?;
+    let shape = b.shape.clone();
+    output(py, &shape, rows.into_iter().map(|[k]| k).collect())
+}
+
+/// Largest contact stiffness of eqs. 5-11 over contact widths in [lo, hi].
+///
+/// A log-spaced scan brackets the maximum, a golden-section search refines it (1e-10 relative
+/// in width). With the errata corrected, k decreases with width over every physical width, so
+/// the paper's maximum near 5 mm is not reproduced: a bracket of physical widths raises
+/// ParameterError ("no interior maximum"); the formal maximum lies near 1e-8 m, where the
+/// Hertz width is far larger than the radii.
+///
+/// Parameters
+/// ----------
+/// r1, r2 : float
+///     Pin radius and magnitude of the disc radius of curvature [m] (see contact_stiffness).
+/// condition : {"convex-convex", "convex-concave"}
+/// lo, hi : float
+///     Width bracket [m], 0 < lo < hi.
+/// youngs_modulus [Pa], poisson_ratio [-], exponent [-], penetration [m]
+///     As in contact_stiffness.
+///
+/// Returns
+/// -------
+/// (float, float)
+///     (width at the maximum [m], k_max [N/m^exponent]).
+///
+/// Raises
+/// ------
+/// ParameterError
+///     Invalid inputs, or no interior maximum in [lo, hi] (the largest value is at an end).
+#[pyfunction]
+#[pyo3(signature = (r1, r2, condition="convex-convex", lo=1e-4, hi=0.1, youngs_modulus=2.17e11, poisson_ratio=0.3, exponent=1.5, penetration=1e-5))]
+#[allow(clippy::too_many_arguments)]
+fn stiffness_maximum(
+    py: Python<'_>,
+    r1: f64,
+    r2: f64,
+    condition: &str,
+    lo: f64,
+    hi: f64,
+    youngs_modulus: f64,
+    poisson_ratio: f64,
+    exponent: f64,
+    penetration: f64,
+) -> PyResult<(f64, f64)> {
+    let condition = ContactCondition::parse(condition)?;
+    let material = Material::new(youngs_modulus, poisson_ratio)?;
+    let p = stiffness_params(r1, r2, condition, material, exponent, penetration);
+    Ok(py.detach(|| core_maximum(&p, lo, hi))?)
+}
+
+/// Hertz contact of two parallel cylinders (line contact), element-wise.
+///
+/// With the line load P = F/L, 1/R = 1/r1 + 1/r2 and 1/E* = 2 (1 - nu^2)/E (both bodies of
+/// the same material): half width a = sqrt(4 P R / (pi E*)), peak pressure p0 = 2 P/(pi a),
+/// mean pressure (pi/4) p0, approach of the two axes from Johnson's 2-D formula
+/// sum_k P (1 - nu^2)/(pi E) (2 ln(4 |r_k| / a) - 1) (a model value: 2-D approach needs a
+/// reference depth).
+///
+/// Parameters
+/// ----------
+/// force : float or array_like
+///     Normal force F [N], >= 0.
+/// width : float or array_like
+///     Contact length L along the cylinder axes [m], > 0.
+/// r1, r2 : float or array_like
+///     Radii [m]: positive convex, negative concave (a pin in a root: r2 < 0, |r2| > r1).
+/// youngs_modulus : float
+///     Young's modulus E of both bodies [Pa].
+/// poisson_ratio : float
+///     Poisson's ratio nu of both bodies [-].
+///
+/// Returns
+/// -------
+/// LineContact
+///     Named tuple (half_width [m], peak_pressure [Pa], mean_pressure [Pa], approach [m]);
+///     each a float or an array of the broadcast input shape.
+///
+/// Raises
+/// ------
+/// ParameterError
+///     Negative or non-finite force, non-positive width, invalid material, shapes that do not
+///     broadcast.
+/// GeometryError
+///     Radii that cannot make a Hertz contact (zero, concave-concave, conformal or nested).
+#[pyfunction]
+#[pyo3(signature = (force, width, r1, r2, youngs_modulus=2.17e11, poisson_ratio=0.3))]
+fn hertz_line_contact<'py>(
+    py: Python<'py>,
+    force: FloatArray<'py>,
+    width: FloatArray<'py>,
+    r1: FloatArray<'py>,
+    r2: FloatArray<'py>,
+    youngs_modulus: f64,
+    poisson_ratio: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let m = Material::new(youngs_modulus, poisson_ratio)?;
+    let b = Broadcast::new(vec![
+        ("force", Input::finite("force", "N", &force)?),
+        ("width", Input::finite("width", "m", &width)?),
+        ("r1", Input::finite("r1", "m", &r1)?),
+        ("r2", Input::finite("r2", "m", &r2)?),
+    ])?;
+    let rows = map_broadcast::<4>(py, &b, |b, i| {
+        let c = core_hertz(b.get(0, i), b.get(1, i), b.get(2, i), b.get(3, i), &m, &m)?;
+        Ok([c.half_width, c.peak_pressure, c.mean_pressure, c.approach])
+    })?;
+    let cols = columns(py, &b.shape, rows)?;
+    python_type(py, "LineContact")?.call1(pyo3::types::PyTuple::new(py, cols)?)
+}
+
+/// Force of the ADAMS IMPACT contact law, element-wise.
+///
+/// F = k x^e + STEP(x, 0, 0, depth, cmax) * v for penetration x > 0, else 0; STEP is the cubic
+/// ramp 3 s^2 - 2 s^3 of s = x / depth clamped to [0, 1], so the damping grows from 0 at first
+/// touch to cmax at x >= depth (the force is continuous at contact). F >= 0 always: a contact
+/// that separates fast does not pull.
+///
+/// Parameters
+/// ----------
+/// penetration : float or array_like
+///     Penetration x [m] (positive = overlap; <= 0 means no contact).
+/// velocity : float or array_like
+///     Penetration rate dx/dt [m/s] (positive = closing).
+/// k : float
+///     Stiffness [N/m^exponent] (paper: 3.988e5 N/mm^1.5 = 1.2611e10 N/m^1.5).
+/// exponent : float
+///     Force exponent e [-], >= 1 (paper: 1.5).
+/// cmax : float
+///     Maximum damping coefficient [N s/m], >= 0 (paper: 100 N s/mm = 1e5 N s/m).
+/// depth : float
+///     Penetration at which the damping reaches cmax [m], > 0 (paper: 0.01 mm = 1e-5 m).
+///
+/// Returns
+/// -------
+/// float or numpy.ndarray
+///     Contact force [N] (>= 0), shape of the broadcast penetration and velocity.
+///
+/// Raises
+/// ------
+/// ParameterError
+///     Non-finite inputs, k <= 0, exponent < 1, cmax < 0, depth <= 0, shapes that do not
+///     broadcast.
+#[pyfunction]
+#[pyo3(signature = (penetration, velocity, k, exponent=1.5, cmax=1.0e5, depth=1.0e-5))]
+fn impact_force<'py>(
+    py: Python<'py>,
+    penetration: FloatArray<'py>,
+    velocity: FloatArray<'py>,
+    k: f64,
+    exponent: f64,
+    cmax: f64,
+    depth: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let law = ImpactLaw::new(k, exponent, cmax, depth)?;
+    let b = Broadcast::new(vec![
+        (
+            "penetration",
+            Input::finite("penetration", "m", &penetration)?,
+        ),
+        ("velocity", Input::finite("velocity", "m/s", &velocity)?),
+    ])?;
+    let rows = map_broadcast::<1>(py, &b, |b, i| Ok([law.force(b.get(0, i), b.get(1, i))]))?;
+    output(py, &b.shape, rows.into_iter().map(|[f]| f).collect())
+}
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(contact_stiffness, m)?)?;
+    m.add_function(wrap_pyfunction!(stiffness_maximum, m)?)?;
+    m.add_function(wrap_pyfunction!(hertz_line_contact, m)?)?;
+    m.add_function(wrap_pyfunction!(impact_force, m)?)?;
+    let paper = ImpactLaw::paper();
+    m.add("PAPER_IMPACT_STIFFNESS", paper.stiffness)?;
+    m.add("PAPER_IMPACT_EXPONENT", paper.exponent)?;
+    m.add("PAPER_IMPACT_MAX_DAMPING", paper.max_damping)?;
+    m.add("PAPER_IMPACT_DEPTH", paper.damping_depth)?;
+    let fig3 = StiffnessParams::paper(ContactCondition::ConvexConvex);
+    m.add("PAPER_STIFFNESS_R1", fig3.r1)?;
+    m.add("PAPER_STIFFNESS_R2", fig3.r2)?;
+    Ok(())
+}

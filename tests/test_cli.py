@@ -1,0 +1,110 @@
+"""The command line, run as a user would: ``python -m rvdyn ...`` in a subprocess."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import subprocess
+import sys
+
+import pytest
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def run(*args: str, cwd=None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "rvdyn", *args], capture_output=True,
+                          text=True, timeout=300, cwd=cwd)
+
+
+def test_info_json_has_the_numbers():
+    r = run("info", "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    kin = d["kinematics"]
+    assert kin["ratio"] == 57.0
+    assert kin["speeds"]["sun"]["deg_s"] == pytest.approx(8328.0, rel=1e-14)
+    assert kin["speeds"]["carrier"]["deg_s"] == pytest.approx(146.105, abs=1e-3)
+    for body in ("sun", "crank_absolute", "crank_relative", "disc_spin", "disc_orbit",
+                 "carrier"):
+        v = kin["speeds"][body]
+        assert v["rad_s"] == pytest.approx(v["deg_s"] * 3.141592653589793 / 180, rel=1e-14)
+    op = d["operating_point"]
+    assert op["input_torque_Nm"] == pytest.approx(770.6, abs=0.1)
+    assert op["output_torque_Nm"] == pytest.approx(43.92e3, abs=10)
+    assert op["paper_printed_output_torque_Nm"] == 4024.9
+    assert op["paper_printed_output_torque_consistent"] is False
+    assert op["paper_printed_output_power_W"] == pytest.approx(10.26e3, abs=10)
+    cyc = d["geometry"]["cycloid"]
+    assert cyc["k1"] == pytest.approx(0.72, abs=1e-12)
+    assert cyc["min_convex_radius_m"] == pytest.approx(20.75e-3, abs=0.01e-3)
+    assert cyc["pitch_radius_m"] == pytest.approx(0.1035, abs=1e-12)
+    assert cyc["root_curvature_radius_m"] == pytest.approx(-10.72e-3, abs=0.005e-3)
+    assert cyc["disc_mass_kg"] == pytest.approx(14.7, rel=0.02)
+    assert cyc["disc_inertia_kg_m2"] == pytest.approx(0.163, rel=0.02)
+    assert d["geometry"]["involute"]["contact_ratio"] == pytest.approx(1.63, abs=0.005)
+    st = d["stiffness"]
+    assert st["r1_m"] == 0.010 and st["r2_m"] == 0.1035
+    for cond, paper in (("convex-convex", 3.988e5), ("convex-concave", 5.093e5)):
+        e = st["conditions"][cond]
+        assert e["paper_maximum_N_per_mm1_5"] == paper
+        assert e["k_at_5mm_N_per_mm1_5"] == pytest.approx(
+            e["k_at_5mm_N_per_m1_5"] / 1000**1.5, rel=1e-14)
+        # Errata corrected: no maximum over physical widths (reported, not hidden).
+        assert e["maximum"] is None and "no interior maximum" in e["maximum_note"]
+        assert e["formal_maximum"]["width_m"] < 1e-6
+    assert st["conditions"]["convex-convex"]["k_at_5mm_N_per_mm1_5"] == \
+        pytest.approx(28408.99, rel=1e-6)
+
+
+def test_info_text():
+    r = run("info")
+    assert r.returncode == 0, r.stderr
+    for fragment in ("ratio i", "= 57", "146.105 deg/s", "770.55 N m", "43.92 kN m",
+                     "INCONSISTENT", "10.3 kW", "K1 = 0.7200", "convex-concave"):
+        assert fragment in r.stdout, fragment
+
+
+@pytest.mark.parametrize("command, name", [("plot-geometry", "geometry.png"),
+                                           ("plot-stiffness", "stiffness.png")])
+def test_plot_commands_write_pngs(tmp_path, command, name):
+    out = tmp_path / "figs"
+    r = run(command, "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    png = out / name
+    data = png.read_bytes()
+    assert data.startswith(PNG_SIGNATURE) and len(data) > 10_000
+    assert str(png) in r.stdout
+
+
+def test_plot_geometry_options_and_default_folder(tmp_path):
+    r = run("plot-geometry", "--psi", "0.7", "--disc", "front", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "rvdyn-out" / "geometry.png").stat().st_size > 10_000
+
+
+def test_paper_command(tmp_path):
+    if importlib.util.find_spec("rvdyn.paper") is None:
+        # Before the paper job exists the command says so and exits with the usage code.
+        r = run("paper", "--t-end", "0.1")
+        assert r.returncode == 2
+        assert "not available in this version" in r.stderr
+        return
+    # The wiring only (rvdyn.paper has its own tests): a short idle run writes its summary.
+    # 0.3 s is several crank revolutions (the averaging window needs at least one).
+    out = tmp_path / "paper"
+    r = run("paper", "--t-end", "0.3", "--load", "idle", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    assert (out / "summary.json").stat().st_size > 0
+
+
+def test_usage_errors_and_help():
+    assert run("--help").returncode == 0
+    r = run()
+    assert r.returncode == 2 and "usage" in r.stderr
+    r = run("info", "--bogus")
+    assert r.returncode == 2
+    r = run("paper", "--load", "heavy")
+    assert r.returncode == 2 and "invalid choice" in r.stderr
+    r = run("--version")
+    assert r.returncode == 0 and "rvdyn" in r.stdout
