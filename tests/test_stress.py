@@ -39,26 +39,53 @@ class Case:
     options: dict[str, Any] = field(default_factory=dict)
     expect: str = "ok"  # "ok" or "error"
     load: str = "rated"
+    #: Start of the whole-revolution mean-speed window [s] (default 20 % of the run).
+    t_start: float | None = None
+    #: Tolerances, with the reason where they differ from the defaults.
+    speed_tol: float = 1e-3
+    energy_tol: float = 0.05
+    #: For expected errors: a phrase the message must contain (the advice).
+    advice: str = "reduce"
 
 
 CASES = [
     Case("default, step start from rest", {}, 0.5),
-    Case("contact stiffness x0.01", {"contact.pin": law(K * 0.01), "contact.mesh": law(K * 0.01)}, 0.5),
+    # Far softer contacts at the rated 35 kN pin load mean approaches near the 0.72 mm concave
+    # radius of the root, where a rigid-profile penalty model stops being meaningful: the run
+    # must stop with advice to raise the stiffness. At lower loads the same laws run.
+    Case("contact stiffness x0.01, rated load", {"contact.pin": law(K * 0.01), "contact.mesh": law(K * 0.01)},
+         0.5, expect="error", advice="too soft"),
+    Case("contact stiffness x0.1, rated load", {"contact.pin": law(K * 0.1), "contact.mesh": law(K * 0.1)},
+         0.5, expect="error", advice="too soft"),
+    Case("contact stiffness x0.1, paper load", {"contact.pin": law(K * 0.1), "contact.mesh": law(K * 0.1)},
+         0.5, load="paper"),
+    Case("contact stiffness x0.01, idle", {"contact.pin": law(K * 0.01), "contact.mesh": law(K * 0.01)},
+         0.5, load="idle", energy_tol=0.1),
     Case("contact stiffness x100", {"contact.pin": law(K * 100), "contact.mesh": law(K * 100)}, 0.5),
     Case("contact stiffness x100, dopri5", {"contact.pin": law(K * 100), "contact.mesh": law(K * 100)}, 0.2,
          "dopri5"),
-    Case("no contact damping", {"contact.pin": law(c=0.0), "contact.mesh": law(c=0.0)}, 0.5),
+    # Undamped: the start-up vibration never decays, so the mean over whole revolutions carries
+    # its phase (1e-2); dopri5 so that the energy balance is not hidden by numerical damping.
+    Case("no contact damping", {"contact.pin": law(c=0.0), "contact.mesh": law(c=0.0)}, 0.5, "dopri5",
+         speed_tol=1e-2, energy_tol=1e-3),
     Case("contact damping x10", {"contact.pin": law(c=10 * C), "contact.mesh": law(c=10 * C)}, 0.5),
     Case("input speed x5", {"drive.speed": 5 * math.radians(8328.0)}, 0.3),
-    Case("idle, step start", {}, 0.5, load="idle"),
-    Case("load step 0 -> rated at 0.1 s", {"load": {"kind": "step", "before": 0.0, "after": RATED, "time": 0.1}}, 0.4),
+    # Idle flows are tiny, so generalized-alpha's numerical damping of the start impact is
+    # ~7 % of them; dopri5 closes the same balance to 1e-6 (next case).
+    Case("idle, step start", {}, 0.5, load="idle", energy_tol=0.1),
+    Case("idle, step start, dopri5", {}, 0.5, "dopri5", load="idle", energy_tol=1e-4),
+    Case("load step 0 -> rated at 0.1 s", {"load": {"kind": "step", "before": 0.0, "after": RATED, "time": 0.1}},
+         0.5, t_start=0.2),
     Case("load reversal rated -> -rated at 0.2 s",
-         {"load": {"kind": "step", "before": RATED, "after": -RATED, "time": 0.2}}, 0.5),
+         {"load": {"kind": "step", "before": RATED, "after": -RATED, "time": 0.2}}, 0.6, t_start=0.3),
     Case("pin clearance 20 um (all pins 20 um smaller)", {"pin_errors.radius": [-2e-5] * 24}, 0.5),
     Case("profile modification d_rrp = +20 um, d_rp = -20 um", {"cycloid.d_rrp": 2e-5, "cycloid.d_rp": -2e-5}, 0.5),
+    Case("compliant joints (default bearings)", {"joints": "compliant"}, 0.5),
+    Case("compliant joints with 10 um bearing clearance",
+         {"joints": {"eccentric_bearing": {"clearance": 1e-5}, "crank_bearing": {"clearance": 1e-5}}}, 0.5),
     Case("60 s run, decimated recording", {}, 60.0, options={"max_samples": 20_000, "channels": ["motion", "pins"]}),
     Case("rk4 at dt = 1e-5 (inside its limit)", {}, 0.2, "rk4", {"dt": 1e-5}),
-    Case("rk4 at dt = 1e-4 (beyond its limit)", {}, 0.2, "rk4", {"dt": 1e-4}, expect="error"),
+    Case("rk4 at dt = 5e-4 (beyond its limit)", {}, 0.2, "rk4", {"dt": 5e-4}, expect="error"),
     Case("dopri5 at atol = 1e-6 m (loose)", {}, 0.2, "dopri5", {"atol": 1e-6}),
     Case("generalized-alpha at dt = 1e-3 (10x default)", {}, 0.5, options={"dt": 1e-3}),
     Case("generalized-alpha at dt = 5e-3 (50x default)", {}, 0.5, options={"dt": 5e-3}),
@@ -66,9 +93,20 @@ CASES = [
 ]
 
 
+def build_scene(case: Case) -> Scene:
+    changes = dict(case.changes)
+    joints = changes.pop("joints", None)
+    scene = Scene.paper(case.load, **changes)
+    if joints == "compliant":
+        scene = scene.with_compliant_joints()
+    elif isinstance(joints, dict):
+        scene = scene.with_compliant_joints(**joints)
+    return scene
+
+
 def run_case(case: Case) -> dict[str, Any]:
     """Run one case and check it; returns a row of the results table."""
-    scene = Scene.paper(case.load, **case.changes)
+    scene = build_scene(case)
     start = time.perf_counter()
     try:
         res = simulate(scene, case.t_end, case.integrator, **case.options)
@@ -81,7 +119,8 @@ def run_case(case: Case) -> dict[str, Any]:
     row["max_penetration"] = float(res.pin_penetration.max())
     row["peak_pin_force"] = float(res.pin_force.max())
     theory = scene["drive.speed"] / 57.0
-    row["speed_error"] = res.mean_output_speed(0.2 * case.t_end) / theory - 1.0
+    t_start = 0.2 * case.t_end if case.t_start is None else case.t_start
+    row["speed_error"] = res.mean_output_speed(t_start) / theory - 1.0
     if "energy_residual" in res.channels:
         row["energy"] = res.energy_balance()["relative_residual"]
     return row
@@ -90,8 +129,7 @@ def run_case(case: Case) -> dict[str, Any]:
 def check(case: Case, row: dict[str, Any]) -> None:
     if case.expect == "error":
         assert row["outcome"] == "SimulationError", row
-        msg = row["message"]
-        assert "reduce" in msg or "use integrator" in msg or "generalized-alpha" in msg, msg
+        assert case.advice in row["message"], row["message"]
         return
     assert row["outcome"] == "ok", row.get("message")
     assert row["finite"]
@@ -100,10 +138,10 @@ def check(case: Case, row: dict[str, Any]) -> None:
     assert row["max_penetration"] < 0.9e-3
     # Whole-revolution mean speed: the gear train cannot slip (stress runs are short and
     # violent: 1e-3 relative).
-    assert abs(row["speed_error"]) < 1e-3
+    assert abs(row["speed_error"]) < case.speed_tol
     # Energy: generalized-alpha's numerical damping of the start impact counts in the residual.
     if "energy" in row:
-        assert row["energy"] < 0.05
+        assert row["energy"] < case.energy_tol
 
 
 @pytest.mark.stress

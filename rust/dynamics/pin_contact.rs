@@ -74,9 +74,12 @@ pub fn pin_query(
         kinematic
     };
     let foot = g.foot_with_fallback(local, seed).ok_or_else(|| {
-        RvdynError::Convergence(format!(
-            "exact gap of pin {} on disc {} not found at t = {t:.6e} s: the disc is far from \
-             its kinematic pose (the run has gone unstable; reduce the step)",
+        // In a run this means the state is unphysical, so it is a simulation failure.
+        RvdynError::Simulation(format!(
+            "exact gap of pin {} on disc {} not found at t = {t:.6e} s: the disc is farther \
+             from its kinematic pose than the profile's radius of curvature; either the run has \
+             gone unstable (reduce the step dt or the tolerances) or the contact is too soft for \
+             the load (raise the contact stiffness)",
             labels.1 + 1,
             labels.0
         ))
