@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import json
 import math
 import signal
@@ -219,3 +221,27 @@ def test_skipping_separated_pins_does_not_change_the_answer() -> None:
     off = simulate(scene, 0.05, channels=["motion", "pins"], skip_separated=False)
     assert np.max(np.abs(on.pin_force - off.pin_force)) < 1e-9 * on.pin_force.max()
     assert np.max(np.abs(on.carrier_angle - off.carrier_angle)) < 1e-12
+
+
+def test_each_integrator_converges_at_its_order_on_a_smooth_scene() -> None:
+    # A smooth version of the rated scene: contact force ~ x^3 (C2 at contact onset) and no
+    # damping ramp, so steps see no kinks; errors against a converged dopri5 run (atol 1e-14).
+    # Generalized-alpha is second order; RK4 shows order > 3 (its fourth order is limited to
+    # ~3.5 by the C2, not C4, contact onsets); dopri5's error falls with its tolerance.
+    law = {"kind": "impact", "stiffness": 1e15, "exponent": 3.0, "max_damping": 0.0, "damping_depth": 1e-5}
+    scene = Scene.paper("rated", **{"contact.pin": law, "contact.mesh": law, "initial": "steady"})
+    kw = {"record_interval": 5e-4, "channels": ["pins"]}
+    ref = simulate(scene, 0.01, "dopri5", atol=1e-14, rtol=1e-13, **kw)
+    peak = ref.pin_force.max()
+
+    def error(**opts: Any) -> float:
+        return float(np.abs(simulate(scene, 0.01, **opts, **kw).pin_force - ref.pin_force).max() / peak)
+
+    ga = [error(integrator="generalized-alpha", dt=dt) for dt in (2e-5, 1e-5, 5e-6)]
+    for coarse, fine in zip(ga, ga[1:]):
+        assert 1.8 < math.log2(coarse / fine) < 2.2
+    rk = [error(integrator="rk4", dt=dt) for dt in (1e-5, 5e-6, 2.5e-6)]
+    for coarse, fine in zip(rk, rk[1:]):
+        assert math.log2(coarse / fine) > 3.0
+    dp = [error(integrator="dopri5", atol=a) for a in (1e-9, 1e-10, 1e-11)]
+    assert dp[0] > dp[1] > dp[2]

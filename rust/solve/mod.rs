@@ -12,6 +12,9 @@ pub mod system;
 
 pub use system::{MechanicalSystem, State};
 
+#[cfg(test)]
+mod tests;
+
 use crate::error::{Result, RvdynError};
 use serde::{Deserialize, Serialize};
 

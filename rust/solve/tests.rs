@@ -1,0 +1,120 @@
+//! Order of convergence of each integrator on a damped linear oscillator with a known exact
+//! solution (smooth, so every method must show its nominal order).
+
+use crate::error::Result;
+use crate::solve::dopri5::Dopri5;
+use crate::solve::generalized_alpha::GeneralizedAlpha;
+use crate::solve::rk4::Rk4;
+use crate::solve::{MechanicalSystem, State};
+
+/// `x'' = -w^2 x - 2 z w x'` in two uncoupled coordinates with different frequencies.
+struct Oscillator {
+    w: [f64; 2],
+    z: f64,
+    scale: [f64; 2],
+}
+
+impl MechanicalSystem for Oscillator {
+    fn dof(&self) -> usize {
+        2
+    }
+    fn eval(&self, _t: f64, q: &[f64], v: &[f64], a: &mut [f64], p: &mut [f64; 3]) -> Result<()> {
+        for i in 0..2 {
+            a[i] = -self.w[i] * self.w[i] * q[i] - 2.0 * self.z * self.w[i] * v[i];
+        }
+        p[2] = (0..2).map(|i| 2.0 * self.z * self.w[i] * v[i] * v[i]).sum();
+        Ok(())
+    }
+    fn length_scale(&self) -> &[f64] {
+        &self.scale
+    }
+}
+
+fn exact(w: f64, z: f64, t: f64) -> f64 {
+    // x(0) = 1, x'(0) = 0.
+    let wd = w * (1.0 - z * z).sqrt();
+    (-z * w * t).exp() * ((wd * t).cos() + z * w / wd * (wd * t).sin())
+}
+
+fn osc() -> Oscillator {
+    Oscillator { w: [3.0, 7.0], z: 0.05, scale: [1.0, 1.0] }
+}
+
+fn error_after(method: &str, h: f64) -> f64 {
+    let sys = osc();
+    let t_end = 2.0;
+    let mut st = State::new(&sys, 0.0, vec![1.0, 1.0], vec![0.0, 0.0]).unwrap();
+    let n = (t_end / h).round() as usize;
+    let mut rk4 = Rk4::default();
+    let mut ga = GeneralizedAlpha::new(0.8, 1e-14, false).unwrap();
+    // Fixed step Dormand-Prince: tolerances so loose that no step is rejected.
+    let mut dp = Dopri5::new(1e10, 1e10, h, h);
+    // Largest error over the whole trajectory (the error at one instant can pass near zero).
+    let mut worst: f64 = 0.0;
+    for _ in 0..n {
+        match method {
+            "rk4" => rk4.step(&sys, &mut st, h).unwrap(),
+            "ga" => ga.step(&sys, &mut st, h).unwrap(),
+            _ => dp.step(&sys, &mut st, t_end).unwrap(),
+        }
+        for i in 0..2 {
+            worst = worst.max((st.q[i] - exact(sys.w[i], sys.z, st.t)).abs());
+        }
+    }
+    worst
+}
+
+fn observed_order(method: &str, h: f64) -> f64 {
+    (error_after(method, h) / error_after(method, h / 2.0)).log2()
+}
+
+#[test]
+fn rk4_is_fourth_order() {
+    let p = observed_order("rk4", 0.01);
+    assert!((p - 4.0).abs() < 0.15, "observed order {p}");
+}
+
+#[test]
+fn dormand_prince_is_fifth_order() {
+    let p = observed_order("dopri", 0.1);
+    assert!((p - 5.0).abs() < 0.3, "observed order {p}");
+}
+
+#[test]
+fn generalized_alpha_is_second_order() {
+    let p = observed_order("ga", 0.005);
+    assert!((p - 2.0).abs() < 0.1, "observed order {p}");
+}
+
+#[test]
+fn adaptive_error_follows_the_tolerance() {
+    let sys = osc();
+    let run = |atol: f64| {
+        let mut st = State::new(&sys, 0.0, vec![1.0, 1.0], vec![0.0, 0.0]).unwrap();
+        let mut dp = Dopri5::new(0.0, atol, 1e-3, 1.0);
+        while st.t < 2.0 {
+            dp.step(&sys, &mut st, 2.0).unwrap();
+        }
+        (0..2).map(|i| (st.q[i] - exact(sys.w[i], sys.z, st.t)).abs()).fold(0.0, f64::max)
+    };
+    let (e1, e2) = (run(1e-6), run(1e-9));
+    // Global error within two decades of the tolerance and shrinking with it.
+    assert!(e1 < 1e-4 && e2 < 1e-7 && e2 < e1 / 50.0, "{e1:e} {e2:e}");
+}
+
+#[test]
+fn energy_flows_integrate_the_dissipation() {
+    // The dissipated work must equal the loss of mechanical energy.
+    let sys = osc();
+    let mut st = State::new(&sys, 0.0, vec![1.0, 1.0], vec![0.0, 0.0]).unwrap();
+    let mut rk4 = Rk4::default();
+    for _ in 0..2000 {
+        rk4.step(&sys, &mut st, 1e-3).unwrap();
+    }
+    let energy = |q: &[f64], v: &[f64]| -> f64 {
+        (0..2).map(|i| 0.5 * v[i] * v[i] + 0.5 * sys.w[i] * sys.w[i] * q[i] * q[i]).sum()
+    };
+    let e0 = energy(&[1.0, 1.0], &[0.0, 0.0]);
+    let lost = e0 - energy(&st.q, &st.v);
+    assert!((lost - st.work[2]).abs() < 1e-9 * e0, "{lost} {}", st.work[2]);
+}
