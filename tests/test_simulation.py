@@ -245,3 +245,24 @@ def test_each_integrator_converges_at_its_order_on_a_smooth_scene() -> None:
         assert math.log2(coarse / fine) > 3.0
     dp = [error(integrator="dopri5", atol=a) for a in (1e-9, 1e-10, 1e-11)]
     assert dp[0] > dp[1] > dp[2]
+
+
+def test_compliant_joints_keep_the_disc_on_its_circle_within_one_percent() -> None:
+    scene = Scene.paper("rated").with_compliant_joints()
+    r = simulate(scene, 0.25)
+    radius = r.disc_path_radius(0.1)
+    assert np.all(np.abs(radius / 4.5e-3 - 1.0) < 0.01)
+    # The discs do move off the rigid path (the bearings deflect under load).
+    assert np.max(np.abs(radius / 4.5e-3 - 1.0)) > 1e-4
+    assert abs(r.mean_output_speed(0.1) / THEORY - 1.0) < 1e-4
+    assert r.crank_angle.shape[1] == 3
+
+
+def test_asking_for_more_channels_does_not_change_the_answer() -> None:
+    scene = Scene.paper("rated")
+    lean = simulate(scene, 0.03, channels=["motion"])
+    full = simulate(scene, 0.03, channels=["motion", "pins", "mesh", "energy", "contact_points"])
+    # Only round-off may differ: the energy channel adds an end-of-step force evaluation,
+    # which moves the Newton warm starts of the exact gap (converged to 1e-13 m either way).
+    np.testing.assert_allclose(lean.carrier_angle, full.carrier_angle, rtol=0, atol=1e-12)
+    assert full.pin_point.shape == (len(full.t), 2, 24, 2)
