@@ -321,8 +321,9 @@ impl RigidModel {
                 let idx = k * self.pins.len() + j;
                 if self.skip_separated {
                     let b = self.separation[idx].get();
-                    let moved = (o[0] - b.centre[0]).hypot(o[1] - b.centre[1])
-                        + self.profile_reach * (th - b.angle).abs();
+                    let (dx, dy) = (o[0] - b.centre[0], o[1] - b.centre[1]);
+                    let moved =
+                        (dx * dx + dy * dy).sqrt() + self.profile_reach * (th - b.angle).abs();
                     if b.gap > moved {
                         sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
                         continue;
