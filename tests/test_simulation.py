@@ -266,3 +266,14 @@ def test_asking_for_more_channels_does_not_change_the_answer() -> None:
     # which moves the Newton warm starts of the exact gap (converged to 1e-13 m either way).
     np.testing.assert_allclose(lean.carrier_angle, full.carrier_angle, rtol=0, atol=1e-12)
     assert full.pin_point.shape == (len(full.t), 2, 24, 2)
+
+
+def test_rk4_beyond_its_stability_limit_stops_with_the_limit() -> None:
+    # Compliant joints at dt = 4e-5 s used to finish with pin forces ~0 (a mode flipping sign
+    # every step, cut by the no-pull clamp): the linearised stability check must stop it.
+    scene = Scene.paper("rated").with_compliant_joints()
+    with pytest.raises(rvdyn.SimulationError, match="stability limit") as info:
+        simulate(scene, 0.1, "rk4", dt=4e-5)
+    assert "reduce dt below" in str(info.value)
+    # Inside the limit it runs.
+    simulate(Scene.paper("rated"), 0.02, "rk4", dt=1e-5)

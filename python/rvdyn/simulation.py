@@ -42,7 +42,8 @@ def simulate(scene: Scene, t_end: float, integrator: str = "generalized-alpha", 
     """Simulate ``scene`` from t = 0 to ``t_end`` [s] and return the recorded :class:`Result`.
 
     integrator: ``"generalized-alpha"`` (implicit, order 2, fixed step ``dt``, default 1e-4 s;
-    ``rho_inf`` in [0, 1] sets its high-frequency damping, default 0.8), ``"dopri5"``
+    ``rho_inf`` in [0, 1] sets its high-frequency damping, default 0.8; ``atol`` [m] is its
+    Newton tolerance on displacements, default 1e-9 m), ``"dopri5"``
     (adaptive Dormand-Prince 5(4); ``atol`` [m] bounds displacement errors, default 1e-9 m;
     ``rtol`` relative velocity tolerance, default 1e-6) or ``"rk4"`` (fixed step ``dt``,
     default 1e-5 s).

@@ -9,7 +9,7 @@ use crate::error::{Result, RvdynError};
 use crate::solve::dopri5::Dopri5;
 use crate::solve::generalized_alpha::GeneralizedAlpha;
 use crate::solve::rk4::Rk4;
-use crate::solve::{Method, State};
+use crate::solve::{Method, State, stability};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Options of one run (SI).
@@ -22,7 +22,8 @@ pub struct SimOptions {
     pub dt: Option<f64>,
     /// Relative tolerance (adaptive method, velocities).
     pub rtol: f64,
-    /// Absolute displacement tolerance [m] (adaptive method).
+    /// Absolute displacement tolerance [m]: the error control of the adaptive method, and the
+    /// Newton tolerance of generalized-alpha.
     pub atol: f64,
     /// Spectral radius at infinity of generalized-alpha.
     pub rho_inf: f64,
@@ -122,6 +123,27 @@ impl RunControl {
     }
 }
 
+/// RK4 steps between two checks of its linearised stability (2 n force evaluations each).
+const RK4_STABILITY_CHECK: u64 = 250;
+
+/// Stop an RK4 run whose step is beyond the method's linearised stability limit at this state.
+fn check_rk4_stability<M: ReducerModel>(sys: &M, st: &State, h: f64) -> Result<()> {
+    let eigs = stability::linearised_eigenvalues(sys, st)?;
+    let growth = stability::rk4_excess_growth(&eigs, h);
+    if growth > 1.0 + 1e-6 {
+        let limit = stability::rk4_step_limit(&eigs, h);
+        return Err(RvdynError::Simulation(format!(
+            "rk4 with dt = {h:.3e} s is beyond its stability limit at t = {:.6e} s: a mode of the \
+             linearised reducer grows {growth:.3} times per step more than it should; the largest \
+             stable step here is about {limit:.3e} s: reduce dt below {:.2e} s or use \
+             integrator=\"generalized-alpha\"",
+            st.t,
+            0.8 * limit
+        )));
+    }
+    Ok(())
+}
+
 /// Simulate `scene` to `options.t_end` and return the recorded channels.
 ///
 /// Errors: `Scene`/`Parameter` for bad input, `Simulation` when the run goes unstable (with
@@ -156,7 +178,7 @@ pub fn run<M: ReducerModel>(sys: &M, opt: &SimOptions, control: &RunControl) -> 
     let dt = opt.dt.unwrap_or_else(|| SimOptions::default_dt(opt.method));
     let mut rk4 = Rk4::default();
     let mut dopri = Dopri5::new(opt.rtol, opt.atol, dt, interval.max(dt));
-    let mut galpha = GeneralizedAlpha::new(opt.rho_inf, opt.atol.min(1e-9), track_work)?;
+    let mut galpha = GeneralizedAlpha::new(opt.rho_inf, opt.atol, track_work)?;
     let n_fixed = (opt.t_end / dt).ceil().max(1.0) as u64;
     let h_fixed = opt.t_end / n_fixed as f64;
     let mut steps: u64 = 0;
@@ -170,7 +192,12 @@ pub fn run<M: ReducerModel>(sys: &M, opt: &SimOptions, control: &RunControl) -> 
         }
         let prev = st.clone();
         match opt.method {
-            Method::Rk4 => rk4.step(sys, &mut st, h_fixed)?,
+            Method::Rk4 => {
+                if steps % RK4_STABILITY_CHECK == 0 {
+                    check_rk4_stability(sys, &st, h_fixed)?;
+                }
+                rk4.step(sys, &mut st, h_fixed)?
+            }
             Method::GeneralizedAlpha => galpha.step(sys, &mut st, h_fixed)?,
             Method::Dopri5 => dopri.step(sys, &mut st, opt.t_end)?,
         }

@@ -8,6 +8,7 @@
 pub mod dopri5;
 pub mod generalized_alpha;
 pub mod rk4;
+pub mod stability;
 pub mod system;
 
 pub use system::{MechanicalSystem, State};

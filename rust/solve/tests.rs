@@ -37,7 +37,11 @@ fn exact(w: f64, z: f64, t: f64) -> f64 {
 }
 
 fn osc() -> Oscillator {
-    Oscillator { w: [3.0, 7.0], z: 0.05, scale: [1.0, 1.0] }
+    Oscillator {
+        w: [3.0, 7.0],
+        z: 0.05,
+        scale: [1.0, 1.0],
+    }
 }
 
 fn error_after(method: &str, h: f64) -> f64 {
@@ -95,7 +99,9 @@ fn adaptive_error_follows_the_tolerance() {
         while st.t < 2.0 {
             dp.step(&sys, &mut st, 2.0).unwrap();
         }
-        (0..2).map(|i| (st.q[i] - exact(sys.w[i], sys.z, st.t)).abs()).fold(0.0, f64::max)
+        (0..2)
+            .map(|i| (st.q[i] - exact(sys.w[i], sys.z, st.t)).abs())
+            .fold(0.0, f64::max)
     };
     let (e1, e2) = (run(1e-6), run(1e-9));
     // Global error within two decades of the tolerance and shrinking with it.
@@ -112,9 +118,15 @@ fn energy_flows_integrate_the_dissipation() {
         rk4.step(&sys, &mut st, 1e-3).unwrap();
     }
     let energy = |q: &[f64], v: &[f64]| -> f64 {
-        (0..2).map(|i| 0.5 * v[i] * v[i] + 0.5 * sys.w[i] * sys.w[i] * q[i] * q[i]).sum()
+        (0..2)
+            .map(|i| 0.5 * v[i] * v[i] + 0.5 * sys.w[i] * sys.w[i] * q[i] * q[i])
+            .sum()
     };
     let e0 = energy(&[1.0, 1.0], &[0.0, 0.0]);
     let lost = e0 - energy(&st.q, &st.v);
-    assert!((lost - st.work[2]).abs() < 1e-9 * e0, "{lost} {}", st.work[2]);
+    assert!(
+        (lost - st.work[2]).abs() < 1e-9 * e0,
+        "{lost} {}",
+        st.work[2]
+    );
 }
