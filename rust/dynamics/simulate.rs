@@ -193,7 +193,7 @@ pub fn run<M: ReducerModel>(sys: &M, opt: &SimOptions, control: &RunControl) -> 
         let prev = st.clone();
         match opt.method {
             Method::Rk4 => {
-                if steps % RK4_STABILITY_CHECK == 0 {
+                if steps.is_multiple_of(RK4_STABILITY_CHECK) {
                     check_rk4_stability(sys, &st, h_fixed)?;
                 }
                 rk4.step(sys, &mut st, h_fixed)?
