@@ -93,16 +93,30 @@ class Result:
             raise ParameterError(
                 f"the window from {t0:.3g} s holds less than one crank revolution; run longer or start earlier"
             )
-        # Remaining crank rotation until the end: decreases to 0 in a running reducer.
+        # Remaining crank rotation until the end: decreases to 0 in a running reducer. Find the
+        # sample interval holding the target, then refine on the cubic Hermite interpolant of
+        # the angle (angles and speeds are both recorded), which is O(dt^4) accurate.
+        rel_speed = self.crank_speed[:, 0] - self.carrier_speed
         remaining = np.abs(rel[i0:] - rel[-1])
-        t_window = float(np.interp(turns * 2 * math.pi, remaining[::-1], t[i0:][::-1]))
+        target = turns * 2 * math.pi
+        k = i0 + int(np.nonzero(remaining >= target)[0][-1])
+        sign = math.copysign(1.0, rel[-1] - rel[i0])
+        lo, hi = float(t[k]), float(t[min(k + 1, len(t) - 1)])
+        f = lambda x: sign * (rel[-1] - _hermite(x, t, rel, rel_speed)) - target  # noqa: E731
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            if f(mid) >= 0:
+                lo = mid
+            else:
+                hi = mid
+        t_window = 0.5 * (lo + hi)
         return t_window, float(t[-1])
 
     def mean_output_speed(self, t_start: float | None = None) -> float:
         """Mean carrier speed [rad/s] over whole crank revolutions after ``t_start`` [s]:
         (angle change) / (time), exact for the recorded angles, no averaging of samples."""
         t0, t1 = self.steady_window(t_start)
-        a0 = float(np.interp(t0, self.t, self.carrier_angle))
+        a0 = _hermite(t0, self.t, self.carrier_angle, self.carrier_speed)
         return (float(self.carrier_angle[-1]) - a0) / (t1 - t0)
 
     def disc_path_radius(self, t_start: float | None = None) -> np.ndarray:
@@ -216,6 +230,15 @@ class Result:
         ax.set(xlabel="time [s]", ylabel="energy [J]")
         ax.legend(fontsize="small")
         return ax
+
+
+def _hermite(x: float, t: np.ndarray, y: np.ndarray, dy: np.ndarray) -> float:
+    """Cubic Hermite interpolation of samples ``y`` with derivatives ``dy`` at time ``x``."""
+    i = int(np.clip(np.searchsorted(t, x) - 1, 0, len(t) - 2))
+    h = float(t[i + 1] - t[i])
+    s = (x - float(t[i])) / h
+    h00, h10, h01, h11 = (1 + 2 * s) * (1 - s) ** 2, s * (1 - s) ** 2, s * s * (3 - 2 * s), s * s * (s - 1)
+    return float(h00 * y[i] + h10 * h * dy[i] + h01 * y[i + 1] + h11 * h * dy[i + 1])
 
 
 def _axes(ax: Any) -> Any:
