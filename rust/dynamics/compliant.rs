@@ -41,7 +41,7 @@ use std::cell::Cell;
 use std::f64::consts::TAU;
 
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
-use crate::dynamics::pin_contact::{DiscPose, penetration_error, pin_contact};
+use crate::dynamics::pin_contact::{DiscPose, WarmStart, penetration_error, pin_contact};
 use crate::dynamics::rigid::RigidModel;
 use crate::dynamics::scene::{Bearing, Initial, Joints, Scene};
 use crate::dynamics::sink::{ContactSink, NoSink};
@@ -152,7 +152,7 @@ pub struct CompliantModel {
     scale: Vec<f64>,
     /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start;
     /// the contact found does not depend on it).
-    warm_seeds: Vec<Cell<f64>>,
+    warm_seeds: Vec<Cell<WarmStart>>,
 }
 
 #[inline]
@@ -274,7 +274,7 @@ impl CompliantModel {
             prescribed,
             input,
             scale,
-            warm_seeds: vec![Cell::new(f64::NAN); nd * zp],
+            warm_seeds: vec![Cell::new(WarmStart::default()); nd * zp],
         })
     }
 

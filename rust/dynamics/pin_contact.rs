@@ -27,6 +27,24 @@ impl DiscPose {
     }
 }
 
+/// The foot parameter of a (disc, pin) contact at the previous evaluation, with its cosine and
+/// sine: the Newton warm start of the next one.
+#[derive(Debug, Clone, Copy)]
+pub struct WarmStart {
+    pub phi: f64,
+    pub cos_sin: [f64; 2],
+}
+
+impl Default for WarmStart {
+    /// No warm start yet (never within reach of a kinematic seed).
+    fn default() -> Self {
+        Self {
+            phi: f64::NAN,
+            cos_sin: [1.0, 0.0],
+        }
+    }
+}
+
 /// A pin in contact with a disc (fixed frame, SI).
 #[derive(Debug, Clone, Copy)]
 pub struct PinContact {
@@ -61,19 +79,21 @@ pub fn pin_query(
     pose: &DiscPose,
     t: f64,
     labels: (usize, usize),
-    warm: &Cell<f64>,
+    warm: &Cell<WarmStart>,
 ) -> Result<PinContact> {
     let g = &disc.geometry;
     let (centre, angle, s, c) = (pose.centre, pose.angle, pose.sin, pose.cos);
     let dp = [pin.centre[0] - centre[0], pin.centre[1] - centre[1]];
     let local = g.remove_rotation_mod([c * dp[0] + s * dp[1], -s * dp[0] + c * dp[1]]);
     let kinematic = pin.angle - angle - g.params().d_delta;
-    let seed = if (warm.get() - kinematic).abs() < 0.05 {
-        warm.get()
+    let w = warm.get();
+    let (seed, cs) = if (w.phi - kinematic).abs() < 0.05 {
+        (w.phi, w.cos_sin)
     } else {
-        kinematic
+        let (s, c) = kinematic.sin_cos();
+        (kinematic, [c, s])
     };
-    let foot = g.foot_with_fallback(local, seed).ok_or_else(|| {
+    let foot = g.foot_with_fallback_cs(local, seed, cs).ok_or_else(|| {
         // In a run this means the state is unphysical, so it is a simulation failure.
         RvdynError::Simulation(format!(
             "exact gap of pin {} on disc {} not found at t = {t:.6e} s: the disc is farther \
@@ -84,7 +104,10 @@ pub fn pin_query(
             labels.0
         ))
     })?;
-    warm.set(foot.phi);
+    warm.set(WarmStart {
+        phi: foot.phi,
+        cos_sin: foot.cos_sin,
+    });
     let r_gen = g.generating_pin_radius();
     let gap = foot.dist + r_gen - pin.radius;
     let nl = g.apply_rotation_mod(foot.normal);
@@ -108,7 +131,7 @@ pub fn pin_contact(
     pose: &DiscPose,
     t: f64,
     labels: (usize, usize),
-    warm: &Cell<f64>,
+    warm: &Cell<WarmStart>,
 ) -> Result<Option<PinContact>> {
     let q = pin_query(disc, pin, pose, t, labels, warm)?;
     Ok((q.penetration > 0.0).then_some(q))

@@ -14,7 +14,7 @@
 
 use crate::contact::ImpactLaw;
 use crate::dynamics::drive::DriveProfile;
-use crate::dynamics::pin_contact::{DiscPose, penetration_error, pin_query};
+use crate::dynamics::pin_contact::{DiscPose, WarmStart, penetration_error, pin_query};
 use crate::dynamics::scene::{Initial, Joints, Load, Scene};
 use crate::dynamics::sink::ContactSink;
 use crate::error::{Result, RvdynError};
@@ -108,7 +108,7 @@ pub struct RigidModel {
     /// Penetration beyond which a run is declared unstable [m].
     pub max_penetration: f64,
     /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start).
-    pub warm_seeds: Vec<Cell<f64>>,
+    pub warm_seeds: Vec<Cell<WarmStart>>,
     /// Skip the exact query of a pin that provably cannot touch (see [`SeparationBound`]).
     pub skip_separated: bool,
     separation: Vec<Cell<SeparationBound>>,
@@ -223,7 +223,7 @@ impl RigidModel {
             length_scale,
             // A tenth of the pin radius is far beyond any elastic approach of steel.
             max_penetration: 0.1 * cyc.pin_radius,
-            warm_seeds: vec![Cell::new(f64::NAN); scene.discs.len() * zp],
+            warm_seeds: vec![Cell::new(WarmStart::default()); scene.discs.len() * zp],
             skip_separated: true,
             separation: vec![
                 Cell::new(SeparationBound {

@@ -195,6 +195,12 @@ impl CycloidGeometry {
     #[inline]
     pub(crate) fn jet(&self, phi: f64) -> CurveJet {
         let (s1, c1) = phi.sin_cos();
+        self.jet_cs(c1, s1)
+    }
+
+    /// As [`CycloidGeometry::jet`] from `cos phi` and `sin phi`.
+    #[inline]
+    pub(crate) fn jet_cs(&self, c1: f64, s1: f64) -> CurveJet {
         // (cos zp phi, sin zp phi) as the zp-th power of (cos phi, sin phi): half the cost of a
         // second sin_cos, relative error ~zp * eps (1e-17 m at the default eccentricity).
         let (cz, sz) = complex_pow(c1, s1, self.params.pins);

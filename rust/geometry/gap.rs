@@ -17,6 +17,15 @@ use std::f64::consts::PI;
 pub const FOOT_TOLERANCE: f64 = 1e-8;
 const MAX_NEWTON: u32 = 40;
 
+/// `(sin x, cos x)` for `|x| < 0.01` by their Taylor series (truncation below 1e-20).
+#[inline]
+fn small_sin_cos(x: f64) -> (f64, f64) {
+    let x2 = x * x;
+    let s = x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
+    let c = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
+    (s, c)
+}
+
 /// Result of an exact gap query, in the fixed frame (SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PinGap {
@@ -38,6 +47,8 @@ pub struct PinGap {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct LocalFoot {
     pub phi: f64,
+    /// `cos phi`, `sin phi`.
+    pub cos_sin: [f64; 2],
     /// Signed distance `(p - C) . n` [m].
     pub dist: f64,
     /// Outward unit normal at the foot.
@@ -122,7 +133,19 @@ impl CycloidGeometry {
     /// Foot from `seed`, with the polyline seed as the fallback. Unrotated disc frame.
     #[inline]
     pub(crate) fn foot_with_fallback(&self, p: [f64; 2], seed: f64) -> Option<LocalFoot> {
-        match self.foot(p, seed) {
+        let (s, c) = seed.sin_cos();
+        self.foot_with_fallback_cs(p, seed, [c, s])
+    }
+
+    /// As [`CycloidGeometry::foot_with_fallback`] with `cos` and `sin` of the seed given.
+    #[inline]
+    pub(crate) fn foot_with_fallback_cs(
+        &self,
+        p: [f64; 2],
+        seed: f64,
+        cs: [f64; 2],
+    ) -> Option<LocalFoot> {
+        match self.foot_cs(p, seed, cs) {
             Some(f) => Some(f),
             None => self.foot(p, self.seed.seed(p)?),
         }
@@ -132,10 +155,21 @@ impl CycloidGeometry {
     /// distance (the point is beyond a centre of curvature) or does not converge.
     #[inline]
     pub(crate) fn foot(&self, p: [f64; 2], seed: f64) -> Option<LocalFoot> {
+        let (s, c) = seed.sin_cos();
+        self.foot_cs(p, seed, [c, s])
+    }
+
+    /// As [`CycloidGeometry::foot`] with `cos` and `sin` of the seed given (a caller that kept
+    /// them from the previous foot saves the trigonometry). Small Newton steps turn
+    /// `(cos, sin)` by the step's rotation (Taylor series to the 9th order: exact to round-off
+    /// for steps below 0.01 rad) instead of evaluating `sin_cos` again.
+    #[inline]
+    pub(crate) fn foot_cs(&self, p: [f64; 2], seed: f64, seed_cs: [f64; 2]) -> Option<LocalFoot> {
         let max_step = PI / (2.0 * f64::from(self.pins()));
         let mut phi = seed;
+        let [mut c1, mut s1] = seed_cs;
         for it in 1..=MAX_NEWTON {
-            let j = self.jet(phi);
+            let j = self.jet_cs(c1, s1);
             let r = [j.c[0] - p[0], j.c[1] - p[1]];
             let f = r[0] * j.d1[0] + r[1] * j.d1[1];
             let d1sq = j.d1[0] * j.d1[0] + j.d1[1] * j.d1[1];
@@ -145,16 +179,24 @@ impl CycloidGeometry {
             }
             let step = (-f / fp).clamp(-max_step, max_step);
             phi += step;
+            [c1, s1] = if step.abs() < 0.01 {
+                let (ds, dc) = small_sin_cos(step);
+                [c1 * dc - s1 * ds, s1 * dc + c1 * ds]
+            } else {
+                let (s, c) = phi.sin_cos();
+                [c, s]
+            };
             if step.abs() * d1sq.sqrt() < FOOT_TOLERANCE {
-                // The last step moved the foot by < 1e-13 m: update the jet to first order
-                // instead of evaluating it again (the distance is stationary at the foot, so
-                // the gap error is second order, ~1e-26 m).
+                // The last step moved the foot by < FOOT_TOLERANCE: update the jet to first
+                // order instead of evaluating it again (foot error < 1e-13 m; the distance is
+                // stationary at the foot, so the gap error is far smaller).
                 let c = [j.c[0] + step * j.d1[0], j.c[1] + step * j.d1[1]];
                 let d1 = [j.d1[0] + step * j.d2[0], j.d1[1] + step * j.d2[1]];
                 let n = Self::normal_from_tangent(d1);
                 let dist = (p[0] - c[0]) * n[0] + (p[1] - c[1]) * n[1];
                 return Some(LocalFoot {
                     phi,
+                    cos_sin: [c1, s1],
                     dist,
                     normal: n,
                     centre_point: c,
@@ -362,6 +404,18 @@ mod tests {
             assert!((global.gap - seeded.gap).abs() < 1e-14);
             let bad = g.gap_seeded(pin, 0.01, c, a, th - a + 0.9).unwrap();
             assert!((global.gap - bad.gap).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn small_angle_sin_cos_is_exact_to_round_off() {
+        for i in -100..=100 {
+            let x = 1e-4 * f64::from(i);
+            let (s, c) = small_sin_cos(x);
+            assert!(
+                (s - x.sin()).abs() < 2e-17 && (c - x.cos()).abs() < 2e-16,
+                "{x}"
+            );
         }
     }
 
