@@ -29,10 +29,10 @@ pub struct GeneralizedAlpha {
     pub track_work: bool,
     lu: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
     lu_h: f64,
-    /// Acceleration at the start of the previous step and that step's size: the linear
-    /// extrapolation `2 a_n - a_(n-1)` starts Newton close to the answer, so that one
-    /// iteration usually meets the tolerance.
-    previous: Option<(Vec<f64>, f64)>,
+    /// Contraction factor of the Newton iteration (see `newton`).
+    theta: f64,
+    /// Steps accepted after one iteration since theta was last measured.
+    unmeasured: u32,
     pub jacobians: u64,
     pub newton_iterations: u64,
     pub splits: u64,
@@ -62,7 +62,8 @@ impl GeneralizedAlpha {
             track_work,
             lu: None,
             lu_h: 0.0,
-            previous: None,
+            theta: 1.0,
+            unmeasured: 0,
             jacobians: 0,
             newton_iterations: 0,
             splits: 0,
@@ -84,7 +85,6 @@ impl GeneralizedAlpha {
     ) -> Result<()> {
         match self.try_step(sys, st, h) {
             Ok(Some(next)) => {
-                self.previous = Some((std::mem::take(&mut st.a), h));
                 *st = next;
                 Ok(())
             }
@@ -129,12 +129,11 @@ impl GeneralizedAlpha {
         let n = st.q.len();
         let (am, af, b, g) = (self.am, self.af, self.beta, self.gamma);
         let scale = sys.length_scale();
-        let mut a1 = match &self.previous {
-            Some((a_prev, h_prev)) if *h_prev == h && a_prev.len() == n => {
-                (0..n).map(|i| 2.0 * st.a[i] - a_prev[i]).collect()
-            }
-            _ => st.a.clone(),
-        };
+        // Start from the old acceleration: the first increment then measures the change over
+        // the step, and accepting only a small increment keeps small steps accurate (a
+        // predictor that starts closer lets the displacement test, which scales with h^2,
+        // accept a poorly converged acceleration at small h).
+        let mut a1 = st.a.clone();
         let mut q1 = vec![0.0; n];
         let mut v1 = vec![0.0; n];
         let mut qf = vec![0.0; n];
@@ -145,7 +144,8 @@ impl GeneralizedAlpha {
         let Some(lu) = self.lu.as_ref() else {
             return Ok(None);
         };
-        for _ in 0..self.max_newton {
+        let mut previous_size = f64::NAN;
+        for iteration in 0..self.max_newton {
             for i in 0..n {
                 q1[i] = st.q[i] + h * st.v[i] + h * h * ((0.5 - b) * st.a[i] + b * a1[i]);
                 v1[i] = st.v[i] + h * ((1.0 - g) * st.a[i] + g * a1[i]);
@@ -167,7 +167,31 @@ impl GeneralizedAlpha {
             if !size.is_finite() {
                 return Ok(None);
             }
-            if size < self.newton_tol {
+            // Hairer's test: the error left after this increment is about theta/(1 - theta)
+            // times it, theta the contraction of the iteration (kept from the last step that
+            // took two iterations; 1 after a new Jacobian, which forces a second iteration).
+            if iteration > 0 {
+                self.theta = (size / previous_size).min(1.0);
+            }
+            previous_size = size;
+            // One iteration is trusted only while theta is fresh: every fourth step measures it
+            // again, since a contact change can slow the iteration without any failure showing.
+            let trusted = iteration > 0 || self.unmeasured < 3;
+            let remaining = if self.theta < 1.0 && trusted {
+                self.theta / (1.0 - self.theta) * size
+            } else {
+                f64::INFINITY
+            };
+            if remaining < self.newton_tol || (iteration > 0 && size < 1e-3 * self.newton_tol) {
+                if iteration == 0 {
+                    self.unmeasured += 1;
+                } else {
+                    self.unmeasured = 0;
+                    if self.theta > 0.3 {
+                        // Slow contraction: the reused Jacobian is stale; refresh it next step.
+                        self.lu = None;
+                    }
+                }
                 for i in 0..n {
                     q1[i] = st.q[i] + h * st.v[i] + h * h * ((0.5 - b) * st.a[i] + b * a1[i]);
                     v1[i] = st.v[i] + h * ((1.0 - g) * st.a[i] + g * a1[i]);
@@ -226,6 +250,7 @@ impl GeneralizedAlpha {
         self.jacobians += 1;
         self.lu = Some(jac.lu());
         self.lu_h = h;
+        self.theta = 1.0;
         Ok(())
     }
 }
