@@ -176,7 +176,9 @@ impl GeneralizedAlpha {
             previous_size = size;
             // One iteration is trusted only while theta is fresh: every fourth step measures it
             // again, since a contact change can slow the iteration without any failure showing.
-            let trusted = iteration > 0 || self.unmeasured < 3;
+            // It is also not trusted for a large first increment (a violent step, such as an
+            // impact, where the linear model behind theta says little).
+            let trusted = iteration > 0 || (self.unmeasured < 3 && size < 100.0 * self.newton_tol);
             let remaining = if self.theta < 1.0 && trusted {
                 self.theta / (1.0 - self.theta) * size
             } else {
