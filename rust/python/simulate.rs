@@ -180,18 +180,39 @@ fn simulate<'py>(
     )?;
     let control = RunControl::default();
     let start = Instant::now();
-    let outcome = std::thread::scope(|s| -> PyResult<Result<Recording, RvdynError>> {
-        let worker = s.spawn(|| crate::dynamics::simulate(&sc, &opt, &control));
+    let outcome = std::thread::scope(|s| -> PyResult<(Result<Recording, RvdynError>, f64)> {
+        // The worker reports through a channel, so this thread wakes the moment it is done
+        // (and every 50 ms meanwhile, for Ctrl-C and the progress bar).
+        let (tx, rx) = std::sync::mpsc::channel();
+        // A Mutex makes the receiver shareable with the GIL-free closure below.
+        let rx = std::sync::Mutex::new(rx);
+        let (sc, opt, control) = (&sc, &opt, &control);
+        let worker = s.spawn(move || {
+            let t0 = Instant::now();
+            let r = crate::dynamics::simulate(sc, opt, control);
+            let _ = tx.send((r, t0.elapsed().as_secs_f64()));
+        });
         let mut last_draw = Instant::now();
         loop {
-            py.detach(|| {
-                let until = Instant::now() + Duration::from_millis(50);
-                while !worker.is_finished() && Instant::now() < until {
-                    std::thread::sleep(Duration::from_millis(2));
-                }
+            let received = py.detach(|| match rx.lock() {
+                Ok(rx) => rx.recv_timeout(Duration::from_millis(50)),
+                Err(_) => Err(std::sync::mpsc::RecvTimeoutError::Disconnected),
             });
-            if worker.is_finished() {
-                break;
+            match received {
+                Ok(done) => {
+                    if progress {
+                        draw_progress(opt.t_end, opt.t_end, start.elapsed().as_secs_f64());
+                        eprintln!();
+                    }
+                    let _ = worker.join();
+                    return Ok(done);
+                }
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                        "the simulation thread panicked (a bug: please report it)",
+                    ));
+                }
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
             }
             if let Err(e) = py.check_signals() {
                 control.request_stop();
@@ -206,18 +227,10 @@ fn simulate<'py>(
                 last_draw = Instant::now();
             }
         }
-        if progress {
-            draw_progress(opt.t_end, opt.t_end, start.elapsed().as_secs_f64());
-            eprintln!();
-        }
-        worker.join().map_err(|_| {
-            pyo3::exceptions::PyRuntimeError::new_err(
-                "the simulation thread panicked (a bug: please report it)",
-            )
-        })
     })?;
-    let mut rec = outcome?;
-    rec.stats.insert("wall_time", start.elapsed().as_secs_f64());
+    let (result, core_time) = outcome;
+    let mut rec = result?;
+    rec.stats.insert("wall_time", core_time);
     to_python(py, rec)
 }
 
