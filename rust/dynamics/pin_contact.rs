@@ -3,6 +3,7 @@
 
 use crate::dynamics::rigid::{DiscModel, PinModel};
 use crate::error::{Result, RvdynError};
+use crate::geometry::gap::small_sin_cos;
 use std::cell::Cell;
 
 /// Where a disc is: centre [m], angle [rad] and the angle's sine and cosine (computed once per
@@ -32,6 +33,8 @@ impl DiscPose {
 #[derive(Debug, Clone, Copy)]
 pub struct WarmStart {
     pub phi: f64,
+    /// The kinematic parameter (pin angle minus disc angle) at that evaluation.
+    pub kinematic: f64,
     pub cos_sin: [f64; 2],
 }
 
@@ -40,6 +43,7 @@ impl Default for WarmStart {
     fn default() -> Self {
         Self {
             phi: f64::NAN,
+            kinematic: f64::NAN,
             cos_sin: [1.0, 0.0],
         }
     }
@@ -87,8 +91,14 @@ pub fn pin_query(
     let local = g.remove_rotation_mod([c * dp[0] + s * dp[1], -s * dp[0] + c * dp[1]]);
     let kinematic = pin.angle - angle - g.params().d_delta;
     let w = warm.get();
-    let (seed, cs) = if (w.phi - kinematic).abs() < 0.05 {
-        (w.phi, w.cos_sin)
+    // The foot moves with the disc's rotation (the kinematic parameter) plus a slowly varying
+    // offset from the deflection: seed with the kinematic parameter plus the last offset, and
+    // turn the kept cos/sin by the change instead of evaluating them.
+    let turn = kinematic - w.kinematic;
+    let (seed, cs) = if turn.abs() < 0.01 && (w.phi - w.kinematic).abs() < 0.05 {
+        let (ds, dc) = small_sin_cos(turn);
+        let [c0, s0] = w.cos_sin;
+        (w.phi + turn, [c0 * dc - s0 * ds, s0 * dc + c0 * ds])
     } else {
         let (s, c) = kinematic.sin_cos();
         (kinematic, [c, s])
@@ -106,6 +116,7 @@ pub fn pin_query(
     })?;
     warm.set(WarmStart {
         phi: foot.phi,
+        kinematic,
         cos_sin: foot.cos_sin,
     });
     let r_gen = g.generating_pin_radius();
