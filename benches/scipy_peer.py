@@ -46,14 +46,16 @@ from scipy.integrate import solve_ivp
 import rvdyn
 from rvdyn import Scene, simulate
 
-# Sample interval [s] of both sides; `python benches/scipy_peer.py 1e-3` runs the comparison
-# with 1 ms samples (results then go to scipy_peer_1ms.*).
+# Sample interval [s] of both sides and span of the equal-error runs [s]:
+# `python benches/scipy_peer.py 1e-3` runs the comparison with 1 ms samples (results in
+# scipy_peer_1ms.*), `python benches/scipy_peer.py 1e-3 1.0` over 1 s (scipy_peer_1ms_1s.*).
 RECORD_INTERVAL = float(sys.argv[1]) if len(sys.argv) > 1 else 1e-4
-SUFFIX = "" if RECORD_INTERVAL == 1e-4 else f"_{RECORD_INTERVAL * 1e3:g}ms"
+T_RUN = float(sys.argv[2]) if len(sys.argv) > 2 else 0.2  # span of the equal-error runs [s]
+SUFFIX = ("" if RECORD_INTERVAL == 1e-4 else f"_{RECORD_INTERVAL * 1e3:g}ms") + (
+    "" if T_RUN == 0.2 else f"_{T_RUN:g}s")
 CHANNELS = ["motion", "pins"]
 T_CHECK = 0.02  # span of the same-model check [s]
-T_RUN = 0.2  # span of the equal-error runs [s]
-WINDOW_START = 0.1  # error window [WINDOW_START, T_RUN] [s]
+WINDOW_START = 0.5 * T_RUN  # error window [WINDOW_START, T_RUN] [s]
 SCALING_SPANS = (0.05, 0.1, 0.2)
 SCALING_RTOL = 1e-4
 TARGETS = (1e-2, 1e-3, 1e-4, 1e-5)  # pin-force error / peak
