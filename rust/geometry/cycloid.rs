@@ -72,7 +72,6 @@ pub(crate) struct CurveJet {
     pub c: [f64; 2],
     pub d1: [f64; 2],
     pub d2: [f64; 2],
-    pub d3: [f64; 2],
 }
 
 impl CycloidGeometry {
@@ -209,12 +208,10 @@ impl CycloidGeometry {
         let e = self.params.eccentricity;
         let ez = e * self.zp;
         let ez2 = ez * self.zp;
-        let ez3 = ez2 * self.zp;
         CurveJet {
             c: [r * c1 - e * cz, r * s1 - e * sz],
             d1: [-r * s1 + ez * sz, r * c1 - ez * cz],
             d2: [-r * c1 + ez2 * cz, -r * s1 + ez2 * sz],
-            d3: [r * s1 - ez3 * sz, -r * c1 + ez3 * cz],
         }
     }
 

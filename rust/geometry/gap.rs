@@ -15,9 +15,6 @@ use std::f64::consts::PI;
 /// radius of curvature of the default pin-centre curve, i.e. below 1e-12 m; the gap, which is
 /// stationary at the foot, is exact to round-off.
 pub const FOOT_TOLERANCE: f64 = 2.5e-8;
-/// The same for a Halley step, whose convergence is cubic: the error left is about
-/// `step^3 / rho^2`, below 1e-12 m for steps under 5e-7 m.
-pub const HALLEY_TOLERANCE: f64 = 5e-7;
 const MAX_NEWTON: u32 = 40;
 
 /// `(sin x, cos x)` for `|x| < 0.01` by their Taylor series (truncation below 1e-20).
@@ -181,13 +178,7 @@ impl CycloidGeometry {
             if fp.is_nan() || fp <= 0.0 {
                 return None;
             }
-            // Halley's step (cubic convergence) while its correction of Newton's is mild.
-            let fpp = 3.0 * dot(j.d1, j.d2) + dot(r, j.d3);
-            let newton = -f / fp;
-            let denominator = 1.0 + 0.5 * newton * fpp / fp;
-            let halley = (0.5..2.0).contains(&denominator);
-            let step =
-                if halley { newton / denominator } else { newton }.clamp(-max_step, max_step);
+            let step = (-f / fp).clamp(-max_step, max_step);
             phi += step;
             [c1, s1] = if step.abs() < 0.01 {
                 let (ds, dc) = small_sin_cos(step);
@@ -196,25 +187,16 @@ impl CycloidGeometry {
                 let (s, c) = phi.sin_cos();
                 [c, s]
             };
-            let moved = step.abs() * d1sq.sqrt();
-            let tolerance = if halley {
-                HALLEY_TOLERANCE
-            } else {
-                FOOT_TOLERANCE
-            };
-            if moved < tolerance {
+            if step.abs() * d1sq.sqrt() < FOOT_TOLERANCE {
                 // The last step moved the foot by less than the tolerance: update point and
                 // tangent by their Taylor series instead of evaluating the jet again (errors
-                // ~1e-17 m and ~1e-13 rad; the distance is stationary at the foot).
+                // ~1e-20 m and ~1e-15 rad; the distance is stationary at the foot).
                 let h2 = 0.5 * step * step;
                 let c = [
                     j.c[0] + step * j.d1[0] + h2 * j.d2[0],
                     j.c[1] + step * j.d1[1] + h2 * j.d2[1],
                 ];
-                let d1 = [
-                    j.d1[0] + step * j.d2[0] + h2 * j.d3[0],
-                    j.d1[1] + step * j.d2[1] + h2 * j.d3[1],
-                ];
+                let d1 = [j.d1[0] + step * j.d2[0], j.d1[1] + step * j.d2[1]];
                 let n = Self::normal_from_tangent(d1);
                 let dist = (p[0] - c[0]) * n[0] + (p[1] - c[1]) * n[1];
                 return Some(LocalFoot {
