@@ -264,9 +264,11 @@ def test_asking_for_more_channels_does_not_change_the_answer() -> None:
     scene = Scene.paper("rated")
     lean = simulate(scene, 0.03, channels=["motion"])
     full = simulate(scene, 0.03, channels=["motion", "pins", "mesh", "energy", "contact_points"])
-    # Only round-off may differ: the energy channel adds an end-of-step force evaluation,
-    # which moves the Newton warm starts of the exact gap (converged to 1e-13 m either way).
-    np.testing.assert_allclose(lean.carrier_angle, full.carrier_angle, rtol=0, atol=1e-12)
+    # The energy channel adds an end-of-step force evaluation, which moves the warm starts of
+    # the exact gap (converged to 1e-13 m either way) and so can change whether generalized-
+    # alpha's Newton iteration stops after one or two iterations: the runs may differ within
+    # the Newton tolerance (atol = 1e-9 m, 7e-9 rad at the pin circle); seen: ~1e-11 rad.
+    np.testing.assert_allclose(lean.carrier_angle, full.carrier_angle, rtol=0, atol=1e-10)
     assert full.pin_point.shape == (len(full.t), 2, 24, 2)
 
 
