@@ -44,7 +44,7 @@ use crate::dynamics::model::{Layout, Observation, ReducerModel};
 use crate::dynamics::pin_contact::{DiscPose, WarmStart, penetration_error, pin_contact};
 use crate::dynamics::rigid::RigidModel;
 use crate::dynamics::scene::{Bearing, Initial, Joints, Scene};
-use crate::dynamics::sink::{ContactSink, NoSink};
+use crate::dynamics::sink::{ContactSink, DynSink, NoSink};
 use crate::error::{Result, RvdynError};
 use crate::solve::MechanicalSystem;
 
@@ -638,30 +638,6 @@ impl ReducerModel for CompliantModel {
             kinetic_energy: self.kinetic_energy(&xv),
             potential_energy: flows.potential,
         })
-    }
-}
-
-/// Lets the generic force routine report into a dynamic sink when recording.
-struct DynSink<'a>(&'a mut dyn ContactSink);
-
-impl ContactSink for DynSink<'_> {
-    fn wants_energy(&self) -> bool {
-        self.0.wants_energy()
-    }
-    fn pin(
-        &mut self,
-        k: usize,
-        j: usize,
-        force: f64,
-        pen: f64,
-        moment: f64,
-        point: [f64; 2],
-        normal: [f64; 2],
-    ) {
-        self.0.pin(k, j, force, pen, moment, point, normal);
-    }
-    fn mesh(&mut self, i: usize, force: f64, deflection: f64) {
-        self.0.mesh(i, force, deflection);
     }
 }
 

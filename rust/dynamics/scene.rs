@@ -315,16 +315,7 @@ impl Scene {
         Ok(Scene {
             name: "paper".into(),
             stage1: Some(paper_stage1()?),
-            cycloid: CycloidParams {
-                pins: 24,
-                eccentricity: 4.5e-3,
-                pin_circle_radius: 0.150,
-                pin_radius: 0.010,
-                face_width: 0.040,
-                d_rp: 0.0,
-                d_rrp: 0.0,
-                d_delta: 0.0,
-            },
+            cycloid: CycloidParams::paper(),
             discs: vec![
                 DiscSpec {
                     phase: 0.0,

@@ -39,3 +39,33 @@ pub trait ContactSink {
 /// The sink of the hot path: ignores everything.
 pub struct NoSink;
 impl ContactSink for NoSink {}
+
+/// Lets a generic force routine report into a dynamic sink (the recorder's) when observing.
+pub(crate) struct DynSink<'a>(pub &'a mut dyn ContactSink);
+
+impl ContactSink for DynSink<'_> {
+    fn wants_energy(&self) -> bool {
+        self.0.wants_energy()
+    }
+    fn wants_forces(&self) -> bool {
+        self.0.wants_forces()
+    }
+    fn checks_bounds(&self) -> bool {
+        self.0.checks_bounds()
+    }
+    fn pin(
+        &mut self,
+        k: usize,
+        j: usize,
+        force: f64,
+        pen: f64,
+        moment: f64,
+        point: [f64; 2],
+        normal: [f64; 2],
+    ) {
+        self.0.pin(k, j, force, pen, moment, point, normal);
+    }
+    fn mesh(&mut self, i: usize, force: f64, deflection: f64) {
+        self.0.mesh(i, force, deflection);
+    }
+}

@@ -2,7 +2,7 @@
 
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
 use crate::dynamics::rigid::{CARRIER, CRANK, Forces, RigidModel, SUN};
-use crate::dynamics::sink::{ContactSink, NoSink};
+use crate::dynamics::sink::{ContactSink, DynSink, NoSink};
 use crate::error::Result;
 use crate::solve::MechanicalSystem;
 
@@ -121,35 +121,5 @@ impl ReducerModel for RigidSystem<'_> {
             kinetic_energy: m.kinetic_energy(&xv),
             potential_energy: f.potential,
         })
-    }
-}
-
-/// Lets the generic hot-path force routine report into a dynamic sink when recording.
-struct DynSink<'a>(&'a mut dyn ContactSink);
-
-impl ContactSink for DynSink<'_> {
-    fn wants_energy(&self) -> bool {
-        self.0.wants_energy()
-    }
-    fn wants_forces(&self) -> bool {
-        self.0.wants_forces()
-    }
-    fn checks_bounds(&self) -> bool {
-        self.0.checks_bounds()
-    }
-    fn pin(
-        &mut self,
-        k: usize,
-        j: usize,
-        force: f64,
-        pen: f64,
-        moment: f64,
-        point: [f64; 2],
-        normal: [f64; 2],
-    ) {
-        self.0.pin(k, j, force, pen, moment, point, normal);
-    }
-    fn mesh(&mut self, i: usize, force: f64, deflection: f64) {
-        self.0.mesh(i, force, deflection);
     }
 }

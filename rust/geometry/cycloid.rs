@@ -41,6 +41,23 @@ pub struct CycloidParams {
     pub d_delta: f64,
 }
 
+impl CycloidParams {
+    /// The default disc of the paper's scene (design.md section 7): 24 pins and e = 4.5 mm are
+    /// given; rp = 150 mm, rrp = 10 mm and the 40 mm face width are assumed; no modification.
+    pub fn paper() -> Self {
+        Self {
+            pins: 24,
+            eccentricity: 4.5e-3,
+            pin_circle_radius: 0.150,
+            pin_radius: 0.010,
+            face_width: 0.040,
+            d_rp: 0.0,
+            d_rrp: 0.0,
+            d_delta: 0.0,
+        }
+    }
+}
+
 /// A validated cycloid disc with its exact profile and the polyline used to seed gap queries.
 #[derive(Clone)]
 pub struct CycloidGeometry {
@@ -368,16 +385,7 @@ pub(crate) mod tests {
     use super::*;
 
     pub(crate) fn paper_params() -> CycloidParams {
-        CycloidParams {
-            pins: 24,
-            eccentricity: 4.5e-3,
-            pin_circle_radius: 0.150,
-            pin_radius: 0.010,
-            face_width: 0.040,
-            d_rp: 0.0,
-            d_rrp: 0.0,
-            d_delta: 0.0,
-        }
+        CycloidParams::paper()
     }
 
     #[test]

@@ -10,16 +10,7 @@ use pyo3::types::{PyTuple, PyType};
 /// The default disc of the paper's scene (design.md section 7): 24 pins and e = 4.5 mm are
 /// given; rp = 150 mm, rrp = 10 mm and the 40 mm face width are assumed.
 fn paper_cycloid() -> CycloidParams {
-    CycloidParams {
-        pins: 24,
-        eccentricity: 4.5e-3,
-        pin_circle_radius: 0.150,
-        pin_radius: 0.010,
-        face_width: 0.040,
-        d_rp: 0.0,
-        d_rrp: 0.0,
-        d_delta: 0.0,
-    }
+    CycloidParams::paper()
 }
 
 /// A validated cycloid disc and its pin ring (SI units: m, rad).
