@@ -581,13 +581,7 @@ impl MechanicalSystem for CompliantModel {
 
 impl ReducerModel for CompliantModel {
     fn layout(&self) -> Layout {
-        let m = &self.base;
-        Layout {
-            discs: m.discs.len(),
-            pins: m.pins.len(),
-            cranks: self.cranks,
-            meshes: m.mesh.map_or(0, |x| x.count),
-        }
+        self.base.layout()
     }
 
     fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {

@@ -14,6 +14,7 @@
 
 use crate::contact::ImpactLaw;
 use crate::dynamics::drive::DriveProfile;
+use crate::dynamics::model::Layout;
 use crate::dynamics::pin_contact::{DiscPose, WarmStart, penetration_error, pin_query};
 use crate::dynamics::scene::{Initial, Joints, Load, Scene};
 use crate::dynamics::sink::ContactSink;
@@ -265,6 +266,16 @@ impl RigidModel {
             return (x, v);
         }
         (x, v)
+    }
+
+    /// Sizes of the bodies and contacts (the shapes of recorded arrays).
+    pub fn layout(&self) -> Layout {
+        Layout {
+            discs: self.discs.len(),
+            pins: self.pins.len(),
+            cranks: self.cranks,
+            meshes: self.mesh.map_or(0, |m| m.count),
+        }
     }
 
     /// Number of lobes `zc`.

@@ -69,13 +69,7 @@ impl MechanicalSystem for RigidSystem<'_> {
 
 impl ReducerModel for RigidSystem<'_> {
     fn layout(&self) -> Layout {
-        let m = self.model;
-        Layout {
-            discs: m.discs.len(),
-            pins: m.pins.len(),
-            cranks: m.cranks,
-            meshes: m.mesh.map_or(0, |x| x.count),
-        }
+        self.model.layout()
     }
 
     fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
