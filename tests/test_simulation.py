@@ -281,3 +281,15 @@ def test_rk4_beyond_its_stability_limit_stops_with_the_limit() -> None:
     assert "reduce dt below" in str(info.value)
     # Inside the limit it runs.
     simulate(Scene.paper("rated"), 0.02, "rk4", dt=1e-5)
+
+
+def test_each_bearing_family_can_be_rigid_or_compliant() -> None:
+    both = Scene.paper("rated").with_compliant_joints()
+    ecc_only = Scene.paper("rated").with_compliant_joints(crank_bearing="rigid")
+    assert both.model_info()["dof"] == 16 and ecc_only.model_info()["dof"] == 10
+    assert ecc_only["joints.crank_bearing"] is None
+    r = simulate(ecc_only, 0.25)
+    assert np.all(np.abs(r.disc_path_radius(0.1) / 4.5e-3 - 1.0) < 0.01)
+    assert abs(r.mean_output_speed(0.1) / THEORY - 1.0) < 1e-4
+    with pytest.raises(rvdyn.SceneError, match="'rigid'"):
+        Scene.paper("rated").with_compliant_joints(crank_bearing="stiff")

@@ -71,16 +71,22 @@ class Scene:
         return scene.replace(**changes) if changes else scene
 
     def with_compliant_joints(self, eccentric_bearing: dict[str, float] | None = None,
-                              crank_bearing: dict[str, float] | None = None) -> "Scene":
+                              crank_bearing: dict[str, float] | str | None = None) -> "Scene":
         """This scene with compliant joints: spring-damper bearings between each eccentric and
         its disc hole and between each crank and the carrier (``{stiffness [N/m], damping
-        [N s/m], clearance [m]}``); the discs and crank centres then move freely. Defaults are
-        the assumed values of ``rvdyn._core.default_compliant_joints()`` (eccentric needle
-        bearing 1e9 N/m, 1e4 N s/m; crank bearing 2e9 N/m, 1e4 N s/m; no clearance)."""
+        [N s/m], clearance [m]}``, changes to the defaults); the discs and crank centres then
+        move freely. ``crank_bearing="rigid"`` keeps the crank bearings ideal (the crank centres
+        stay in their seats) with compliant eccentric bearings. Defaults are the assumed values
+        of ``rvdyn._core.default_compliant_joints()`` (eccentric needle bearing 1e9 N/m,
+        1e4 N s/m; crank bearing 2e9 N/m, 1e4 N s/m; no clearance)."""
         joints = json.loads(_core.default_compliant_joints())
         if eccentric_bearing:
             joints["eccentric_bearing"].update(eccentric_bearing)
-        if crank_bearing:
+        if crank_bearing == "rigid":
+            joints["crank_bearing"] = None
+        elif isinstance(crank_bearing, str):
+            raise SceneError(f"crank_bearing must be a dict of changes or 'rigid', got {crank_bearing!r}")
+        elif crank_bearing:
             joints["crank_bearing"].update(crank_bearing)
         return self.replace(joints=joints)
 

@@ -66,11 +66,11 @@ pub fn default_joints() -> Joints {
             damping: 1.0e4,
             clearance: 0.0,
         },
-        crank_bearing: Bearing {
+        crank_bearing: Some(Bearing {
             stiffness: 2.0e9,
             damping: 1.0e4,
             clearance: 0.0,
-        },
+        }),
     }
 }
 
@@ -131,7 +131,9 @@ pub struct CompliantModel {
     /// The rigid model of the same scene: geometry, laws, inertias, drive and load.
     pub base: RigidModel,
     pub eccentric_bearing: Bearing,
-    pub crank_bearing: Bearing,
+    /// `None`: rigid crank bearings, the crank centres stay in their seats on the carrier
+    /// (their mass then turns with the carrier: `n m_cr r_cr^2` joins its inertia).
+    pub crank_bearing: Option<Bearing>,
     /// Number of cranks.
     pub cranks: usize,
     /// `(cos gamma_i, sin gamma_i)` of each crank seat.
@@ -235,7 +237,16 @@ impl CompliantModel {
         let crank_lever = base.mesh.map_or(e, |m| m.planet_base_radius.max(e));
         let n_full = 2 + 3 * n + 3 * nd;
         let zp = base.pins.len();
-        let mut mass = vec![inr.carrier.inertia + inr.load_inertia, inr.sun.inertia];
+        let rigid_cranks = crank_bearing.is_none();
+        let crank_orbit = if rigid_cranks {
+            n as f64 * inr.crank.mass * base.crank_radius * base.crank_radius
+        } else {
+            0.0
+        };
+        let mut mass = vec![
+            inr.carrier.inertia + inr.load_inertia + crank_orbit,
+            inr.sun.inertia,
+        ];
         let mut lever = vec![rp, base.mesh.map_or(0.0, |m| m.sun_base_radius)];
         for _ in 0..n {
             mass.extend([inr.crank.mass, inr.crank.mass, inr.crank.inertia]);
@@ -257,8 +268,12 @@ impl CompliantModel {
             (true, false) => crank_rotations,
             (false, _) => Vec::new(),
         };
+        let crank_centres: Vec<usize> = (0..n)
+            .flat_map(|i| [crank_index(i), crank_index(i) + 1])
+            .collect();
         let free: Vec<usize> = (0..n_full)
             .filter(|i| !prescribed.contains(i) && (*i != SUN || has_mesh))
+            .filter(|i| !(rigid_cranks && crank_centres.contains(i)))
             .collect();
         let scale = free.iter().map(|&i| lever[i]).collect();
         Ok(Self {
@@ -323,6 +338,21 @@ impl CompliantModel {
         (x, v)
     }
 
+    /// With rigid crank bearings, put each crank centre in its seat (and moving with it).
+    #[inline]
+    fn place_rigid_cranks(&self, x: &mut [f64], v: &mut [f64]) {
+        if self.crank_bearing.is_some() {
+            return;
+        }
+        for (i, seat) in self.seats.iter().enumerate() {
+            let ci = crank_index(i);
+            let s = scaled(self.base.crank_radius, rotate(x[CARRIER], *seat));
+            let sv = scaled(v[CARRIER], perp(s));
+            x[ci..ci + 2].copy_from_slice(&s);
+            v[ci..ci + 2].copy_from_slice(&sv);
+        }
+    }
+
     /// Overwrite the prescribed coordinates of a full state with the drive at `t`; returns
     /// the prescribed acceleration.
     #[inline]
@@ -348,6 +378,7 @@ impl CompliantModel {
             xv[i] = v[k];
         }
         let acc = self.apply_drive(t, &mut x, &mut xv);
+        self.place_rigid_cranks(&mut x, &mut xv);
         (x, xv, acc)
     }
 
@@ -407,12 +438,14 @@ impl CompliantModel {
             let d = sub(p, s);
             let dd = sub(pv, s_v);
             // Crank bearing: force on the crank centre, reaction on the carrier at s_i.
-            let b = bearing_load(&self.crank_bearing, d, dd);
-            qf[ci] += b.force[0];
-            qf[ci + 1] += b.force[1];
-            qf[CARRIER] -= cross(s, b.force);
-            out.dissipation += b.dissipation;
-            out.potential += b.energy;
+            if let Some(cb) = &self.crank_bearing {
+                let b = bearing_load(cb, d, dd);
+                qf[ci] += b.force[0];
+                qf[ci + 1] += b.force[1];
+                qf[CARRIER] -= cross(s, b.force);
+                out.dissipation += b.dissipation;
+                out.potential += b.energy;
+            }
             // Eccentric bearings: force on the disc at H, opposite on the crank at E.
             for (k, disc) in m.discs.iter().enumerate() {
                 let dk = self.disc_index(k);
@@ -509,6 +542,17 @@ impl CompliantModel {
                 }
                 // Moment of the pin's force (-f n) on the disc about the disc centre.
                 sink.pin(k, j, f, pen, -f * lever, add(o, pc.arm), n);
+            }
+        }
+        if self.crank_bearing.is_none() {
+            // Rigid crank bearings: a force on a crank centre turns the carrier, through the
+            // seat's lever (virtual work with ds_i/dth_c = z x s_i).
+            for (i, seat) in self.seats.iter().enumerate() {
+                let ci = crank_index(i);
+                let s = scaled(m.crank_radius, rotate(thc, *seat));
+                qf[CARRIER] += cross(s, [qf[ci], qf[ci + 1]]);
+                qf[ci] = 0.0;
+                qf[ci + 1] = 0.0;
             }
         }
         qf[CARRIER] -= m.load.torque(t);
@@ -659,7 +703,7 @@ mod tests {
         };
         Joints::Compliant {
             eccentric_bearing: b,
-            crank_bearing: b,
+            crank_bearing: Some(b),
         }
     }
 
@@ -912,6 +956,55 @@ mod tests {
     /// start with its impact): |residual| < 1e-4 of the input work with dopri5 at atol 1e-10.
     /// Covers the prescribed sun, a torque drive on the sun, and a single-stage reducer whose
     /// cranks are the input (prescribed speed, or a torque shared by the cranks).
+    fn rigid_cranks(k: f64, c: f64) -> Joints {
+        Joints::Compliant {
+            eccentric_bearing: Bearing {
+                stiffness: k,
+                damping: c,
+                clearance: 0.0,
+            },
+            crank_bearing: None,
+        }
+    }
+
+    #[test]
+    fn rigid_crank_bearings_drop_the_crank_translations() {
+        // 16 DOF with both families compliant, 10 with rigid crank bearings.
+        let both = CompliantModel::new(&scene("rated", default_joints(), Initial::Rest)).unwrap();
+        let ecc =
+            CompliantModel::new(&scene("rated", rigid_cranks(1e9, 1e4), Initial::Rest)).unwrap();
+        assert_eq!(both.dof(), 16);
+        assert_eq!(ecc.dof(), 10);
+        // With stiff eccentric bearings it is the rigid model again.
+        let t_end = 0.01;
+        let rigid = run(&scene("rated", Joints::Rigid, Initial::Steady), t_end, 1e-9);
+        let stiff = run(
+            &scene("rated", rigid_cranks(1e12, 3e6), Initial::Steady),
+            t_end,
+            1e-9,
+        );
+        let (fr, fs) = (series(&rigid, "pin_force"), series(&stiff, "pin_force"));
+        let n = fr.len();
+        let worst = fr[n - 48..]
+            .iter()
+            .zip(&fs[n - 48..])
+            .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        assert!(worst < 0.01 * peak(fr), "pin forces differ by {worst} N");
+        let speed = mean_speed(&stiff) / mean_speed(&rigid) - 1.0;
+        assert!(speed.abs() < 1e-4, "{speed:e}");
+        // The energy balance closes with the crank mass moving with the carrier.
+        let r = run(
+            &scene("paper", rigid_cranks(1e9, 1e4), Initial::Rest),
+            0.006,
+            1e-10,
+        );
+        let (res, win) = last_residual(&r);
+        assert!(
+            res.abs() < 1e-4 * win.abs(),
+            "residual {res:e} J of {win:e} J"
+        );
+    }
+
     #[test]
     fn energy_balance_closes() {
         let mut cases = vec![scene("paper", default_joints(), Initial::Rest)];
@@ -967,7 +1060,7 @@ mod tests {
             "idle",
             Joints::Compliant {
                 eccentric_bearing: b(1e9, 10e-6),
-                crank_bearing: b(2e9, 5e-6),
+                crank_bearing: Some(b(2e9, 5e-6)),
             },
             Initial::Rest,
         );

@@ -80,11 +80,17 @@ pub enum Joints {
     /// Ideal joints (the paper): the discs move exactly with the cranks; DOFs carrier, crank.
     Rigid,
     /// Spring-damper bearings: disc translations and rotations, crank translations are DOFs.
+    /// Each family is compliant or rigid on its own where that is consistent: the crank
+    /// bearings may stay rigid (`crank_bearing` omitted or null: the crank centres stay in
+    /// their seats) while the eccentric bearings are compliant. The reverse (rigid eccentric
+    /// bearings on compliant cranks) would tie each disc rigidly to three moving eccentrics,
+    /// an over-constrained mechanism; with both rigid, use `Rigid`.
     Compliant {
         /// Needle bearing between each eccentric and its disc hole.
         eccentric_bearing: Bearing,
-        /// Bearing between each crankshaft and the carrier.
-        crank_bearing: Bearing,
+        /// Bearing between each crankshaft and the carrier; `None` = rigid.
+        #[serde(default)]
+        crank_bearing: Option<Bearing>,
     },
 }
 
@@ -469,9 +475,12 @@ impl Scene {
         } = self.joints
         {
             for (n, b) in [
-                ("eccentric_bearing", eccentric_bearing),
+                ("eccentric_bearing", Some(eccentric_bearing)),
                 ("crank_bearing", crank_bearing),
-            ] {
+            ]
+            .into_iter()
+            .filter_map(|(n, b)| b.map(|b| (n, b)))
+            {
                 if !(b.stiffness.is_finite()
                     && b.stiffness > 0.0
                     && b.damping.is_finite()
