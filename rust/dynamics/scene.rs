@@ -405,7 +405,7 @@ impl Scene {
                     return err(format!("discs[{k}].{n} must be finite, got {v}"));
                 }
             }
-            crate::geometry::CycloidGeometry::new(self.disc_params(k))?;
+            crate::geometry::CycloidGeometry::check(self.disc_params(k))?;
         }
         if self.cranks < 1 {
             return err("cranks must be at least 1".into());

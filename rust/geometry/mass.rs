@@ -57,7 +57,7 @@ pub fn disc_mass_properties(
     density: f64,
 ) -> Result<MassProperties> {
     require_positive("density", density, "kg/m^3")?;
-    let (area, polar) = geometry.profile_area_moments(256);
+    let (area, polar) = geometry.profile_area_moments(128);
     let circle = |r: f64, d: f64| (PI * r * r, PI * r * r * r * r / 2.0 + PI * r * r * d * d);
     let mut a = area;
     let mut j = polar;
@@ -110,11 +110,11 @@ mod tests {
     #[test]
     fn profile_area_is_between_root_and_tip_circles() {
         let g = CycloidGeometry::new(paper_params()).unwrap();
-        let (a, _) = g.profile_area_moments(256);
+        let (a, _) = g.profile_area_moments(128);
         assert!(a > PI * 0.1355f64.powi(2) && a < PI * 0.1445f64.powi(2));
         // Converged in the sampling.
         let (a2, _) = g.profile_area_moments(1024);
-        assert!((a - a2).abs() / a < 1e-13, "{a} {a2}");
+        assert!((a - a2).abs() / a < 1e-12, "{a} {a2}");
     }
 
     #[test]
