@@ -1,3 +1,5 @@
+//! Developer smoke run of the default scene from the command line, without Python:
+//! `cargo run --release --example smoke -- [idle|paper|rated] [integrator] [t_end] [dt]`.
 use rvdyn::dynamics::{RunControl, Scene, SimOptions, simulate};
 use rvdyn::solve::Method;
 fn main() {

@@ -203,7 +203,7 @@ def test_sweep_runs_a_grid_and_reports_failures() -> None:
 
 
 def test_ctrl_c_stops_a_run_cleanly() -> None:
-    code = "import rvdyn; rvdyn.simulate(rvdyn.Scene.paper('rated'), 60.0, channels=['motion'])"
+    code = "import rvdyn; rvdyn.simulate(rvdyn.Scene.paper('rated'), 600.0, channels=['motion'], max_samples=1000)"
     proc = subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE, text=True)
     time.sleep(3.0)
     proc.send_signal(signal.SIGINT)
