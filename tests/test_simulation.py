@@ -293,3 +293,22 @@ def test_each_bearing_family_can_be_rigid_or_compliant() -> None:
     assert abs(r.mean_output_speed(0.1) / THEORY - 1.0) < 1e-4
     with pytest.raises(rvdyn.SceneError, match="'rigid'"):
         Scene.paper("rated").with_compliant_joints(crank_bearing="stiff")
+
+
+def test_classical_pin_forces_match_the_dynamic_model_at_a_slow_linear_run() -> None:
+    # The core's classical reference (CycloidGeometry.classical_pin_forces) against the slow,
+    # linear-law dynamic run of test_pin_forces_follow_classical_load_sharing, using the disc's
+    # own moment as its torque: within 1 % of F_max away from the root.
+    law = {"kind": "impact", "stiffness": 1.0e9, "exponent": 1.0, "max_damping": 2.0e5, "damping_depth": 1e-6}
+    scene = Scene.paper("rated", **{"contact.pin": law, "drive.speed": INPUT_SPEED / 50, "initial": "steady"})
+    res = simulate(scene, 0.4, "dopri5", atol=1e-10, record_interval=1e-3)
+    g = rvdyn.CycloidGeometry.paper()
+    psi = res.crank_angle[-1, 0]
+    torque = -res.pin_moment[-1, 0].sum()
+    classical = g.classical_pin_forces(torque, psi)
+    phi = 2 * np.pi * np.arange(24) / 24 - psi
+    away = np.cos(phi) < math.cos(math.radians(15))
+    f = res.pin_force[-1, 0]
+    assert np.max(np.abs(f - classical)[away]) < 0.01 * f.max()
+    with pytest.raises(rvdyn.ParameterError):
+        g.classical_pin_forces(float("nan"), 0.0)

@@ -116,6 +116,11 @@ class CycloidGeometry:
         point)."""
     def pin_positions(self) -> NDArray[np.float64]:
         """Pin centres (zp, 2) [m]; row j is at angle 2 pi j / zp, the paper's pin j + 1."""
+    def classical_pin_forces(self, disc_torque: float, crank_angle: float) -> NDArray[np.float64]:
+        """Classical quasi-static pin forces (zp,) [N] of the unmodified disc carrying
+        disc_torque [N m] about its centre at crank angle crank_angle [rad]."""
+    def classical_levers(self, crank_angle: float) -> NDArray[np.float64]:
+        """Levers (zp,) [m] of the contact normals about the disc centre at crank angle [rad]."""
     def kinematic_pose(self, psi: float) -> tuple[NDArray[np.float64], float]:
         """Disc centre (2,) [m] = e (cos psi, sin psi) and disc angle -psi/zc [rad] for the
         crank angle psi [rad]."""

@@ -1,1 +1,5 @@
-//! Analysis of runs: quasi-static load sharing.
+//! Analysis: quasi-static references for the dynamic results.
+
+pub mod load_sharing;
+
+pub use load_sharing::{classical_levers, classical_pin_forces};

@@ -307,6 +307,31 @@ impl PyCycloidGeometry {
         output(py, &[n, 2], values)
     }
 
+    /// Classical quasi-static pin forces [N], shape (zp,), of the unmodified disc carrying
+    /// `disc_torque` [N m] about its centre with its centre at crank angle `crank_angle` [rad]
+    /// (notes/physics.md 2.1: F_j = T l_j / sum l^2 on the loaded half).
+    fn classical_pin_forces<'py>(
+        &self,
+        py: Python<'py>,
+        disc_torque: f64,
+        crank_angle: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let f = crate::analysis::classical_pin_forces(&self.inner, disc_torque, crank_angle)?;
+        output(py, &[f.len()], f)
+    }
+
+    /// Classical levers l_j = rc' sin(phi_j)/S_j [m], shape (zp,), of the contact normals
+    /// about the disc centre at crank angle `crank_angle` [rad].
+    fn classical_levers<'py>(
+        &self,
+        py: Python<'py>,
+        crank_angle: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        crate::error::require_finite("crank_angle", crank_angle)?;
+        let l = crate::analysis::classical_levers(&self.inner, crank_angle);
+        output(py, &[l.len()], l)
+    }
+
     /// Rigid-body (kinematic) pose of the disc at crank angle psi, meshing exactly with the
     /// pins: centre e (cos psi, sin psi), rotation -psi / zc.
     ///
