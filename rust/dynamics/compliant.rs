@@ -411,7 +411,7 @@ impl CompliantModel {
     /// contact to `sink`.
     ///
     /// Fails with `SimulationError` if a force is not finite or a penetration exceeds the
-    /// physical bound, and with `ConvergenceError` if an exact gap cannot be found.
+    /// physical bound or an exact gap cannot be found (the disc is far from any sensible pose).
     fn forces<S: ContactSink>(
         &self,
         t: f64,

@@ -312,7 +312,7 @@ impl RigidModel {
     /// Generalised forces at `(t, x, v)` (full coordinates), reporting every contact to `sink`.
     ///
     /// Fails with `SimulationError` if a state is not finite or a penetration exceeds the
-    /// physical bound, and with `ConvergenceError` if an exact gap cannot be found.
+    /// physical bound or an exact gap cannot be found (the disc is far from any sensible pose).
     pub fn forces<S: ContactSink>(
         &self,
         t: f64,
