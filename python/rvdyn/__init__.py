@@ -15,6 +15,8 @@ transmission_ratio, body_speeds, operating_point
     Kinematics and the operating point.
 Scene, simulate, sweep, Result
     Reducer scenes, dynamic runs (one or many in parallel) and their recorded results.
+study
+    Tolerance studies (Monte Carlo / Latin hypercube, threads / processes / Dask / Ray).
 rvdyn.plotting
     Matplotlib figures (geometry, contact stiffness).
 """
@@ -54,6 +56,7 @@ from .errors import (
     SceneError,
     SimulationError,
 )
+from . import study  # noqa: E402  (rvdyn.study(...) runs a tolerance study; see rvdyn.study)
 
 __version__: str = _core.__version__
 
@@ -63,6 +66,7 @@ __all__ = [
     "Result",
     "simulate",
     "sweep",
+    "study",
     "INTEGRATORS",
     "CycloidGeometry",
     "InvoluteStage",
