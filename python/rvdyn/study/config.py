@@ -61,7 +61,7 @@ def _toml(path: Path) -> dict[str, Any]:
         import tomllib
     except ImportError:  # Python 3.10
         try:
-            import tomli as tomllib  # type: ignore[no-redef]
+            import tomli as tomllib  # type: ignore[no-redef, import-not-found, unused-ignore]
         except ImportError:
             raise ParameterError("reading spec.toml on Python 3.10 needs tomli: pip install tomli") from None
     try:
@@ -97,8 +97,9 @@ def _runner(d: dict[str, Any]) -> Any:
             from distributed import Client, LocalCluster
         except ImportError:
             raise ParameterError("[runner] kind = 'dask' needs Dask: pip install 'rvdyn[dask]'") from None
-        cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True, dashboard_address=None)
-        return Client(cluster)
+        cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1,  # type: ignore[no-untyped-call, unused-ignore]
+                               processes=True, dashboard_address=None)
+        return Client(cluster)  # type: ignore[no-untyped-call, unused-ignore]
     if kind == "ray":
         return str(address) if address else f"ray{suffix}"
     raise ParameterError(f"[runner] kind must be 'threads', 'processes', 'dask' or 'ray', got {kind!r}")

@@ -159,7 +159,7 @@ def _dask_client(address: str, timeout: float) -> Any:
     except ImportError:
         raise ParameterError(f"runner {address!r} needs Dask: pip install 'rvdyn[dask]'") from None
     try:
-        return Client(address, timeout=f"{timeout}s")
+        return Client(address, timeout=f"{timeout}s")  # type: ignore[no-untyped-call, unused-ignore]
     except (OSError, TimeoutError) as exc:
         raise ParameterError(f"runner: no Dask scheduler answers at {address!r} within {timeout:g} s ({exc})") from None
 

@@ -99,7 +99,7 @@ def design(layout: Layout, sampler: Any, seed: int | None) -> np.ndarray:
     for cols, chol in layout.groups:
         z = ndtri(u[:, cols])
         u[:, cols] = np.clip(ndtr(z @ chol.T), _EPS, 1.0 - _EPS)
-    out = np.empty_like(u)
+    out: np.ndarray = np.empty_like(u)
     for j, var in enumerate(layout.variables):
         out[:, j] = var.ppf(u[:, j])
     return out

@@ -130,7 +130,7 @@ class Criterion:
 
     def passes(self, values: np.ndarray) -> np.ndarray:
         """Boolean mask of values meeting the criterion (NaN, i.e. a failed sample, fails)."""
-        ok = np.isfinite(values)
+        ok: np.ndarray = np.isfinite(values)
         if self.max is not None:
             ok &= values <= self.max
         if self.min is not None:
