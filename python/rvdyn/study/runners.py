@@ -117,6 +117,7 @@ class Mapper:
         self.owned = owned
         self.retries = retries
         self.in_process = in_process
+        self._scattered: tuple[Any, Any] | None = None
         mod = type(runner).__module__
         self.is_dask = mod.startswith("distributed") and hasattr(runner, "submit") and hasattr(runner, "gather")
 
@@ -133,17 +134,35 @@ class Mapper:
         return out
 
     def _run_dask(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
-        futures = self.runner.map(fn, list(items), pure=False, retries=self.retries)
+        if isinstance(fn, functools.partial) and len(fn.args) == 1 and not fn.keywords:
+            # Send the shared task (scene, kernel, layout) to every worker once, not with each item.
+            if self._scattered is None or self._scattered[0] is not fn.args[0]:
+                [fut] = self.runner.scatter([fn.args[0]], broadcast=True, hash=False)
+                self._scattered = (fn.args[0], fut)
+            futures = self.runner.map(fn.func, [self._scattered[1]] * len(items), list(items), pure=False,
+                                      retries=self.retries)
+        else:
+            futures = self.runner.map(fn, list(items), pure=False, retries=self.retries)
+        from distributed import wait
+
+        wait(futures)
+        done = [f for f in futures if f.status == "finished"]
+        results = iter(self.runner.gather(done, errors="raise")) if done else iter(())
         out: list[Any] = []
         for f in futures:
-            try:
-                out.append(f.result())
-            except Exception as exc:  # noqa: BLE001 - retries exhausted (KilledWorker, ...)
+            if f.status == "finished":
+                out.append(next(results))
+                continue
+            try:  # retries exhausted (KilledWorker, ...) or cancelled
+                exc = f.exception()
                 out.append(_Failure(f"runner failed: {type(exc).__name__}: {exc}"))
-        del futures
+            except Exception as err:  # noqa: BLE001
+                out.append(_Failure(f"runner failed: {type(err).__name__}: {err}"))
+        del futures, done
         return out
 
     def close(self) -> None:
+        self._scattered = None
         if not self.owned:
             return
         for name in ("shutdown", "close"):
