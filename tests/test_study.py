@@ -102,7 +102,8 @@ def test_bad_study_arguments_are_clear_errors() -> None:
 def test_unreachable_cluster_address_is_a_clear_error() -> None:
     pytest.importorskip("distributed")
     with pytest.raises(rvdyn.ParameterError, match="no Dask scheduler answers at 'tcp://127.0.0.1:1'"):
-        rvdyn.study(SCENE, linear_metric, TOLS, samples=2, runner="tcp://127.0.0.1:1")
+        rvdyn.study(SCENE, linear_metric, TOLS, samples=2, runner="tcp://127.0.0.1:1",
+                    connect_timeout=1.0)
 
 
 # ----------------------------------------------------------------------------------- sampling

@@ -43,7 +43,7 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
         criteria: Sequence[Criterion | dict[str, Any]] = (), kernel_options: dict[str, Any] | None = None,
         chunk_size: int = 1000, batch_size: int = 1, retries: int = 2, resume: bool = True,
         retry_failed: bool = False, threads_per_worker: int = 1, as_numpy: bool = False,
-        load: bool = True, progress: bool = False) -> Any:
+        load: bool = True, progress: bool = False, connect_timeout: float = 10.0) -> Any:
     """Run a tolerance study and return its table (one row per sample).
 
     scene: the nominal :class:`rvdyn.Scene`. kernel: ``"dynamic"`` (a dynamic run reduced to
@@ -61,6 +61,7 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
     (``retry_failed=True`` reruns the failed samples too). batch_size: samples per task (raise
     it for cheap kernels on a cluster). retries: Dask retries of a task whose worker died.
     threads_per_worker: native threads of each worker process (RAYON_NUM_THREADS etc.).
+    connect_timeout: seconds to wait for a cluster given by address.
 
     Returns a pandas DataFrame (a numpy structured array without pandas or with
     ``as_numpy=True``); with ``load=False`` and ``out``, the folder path instead.
@@ -99,7 +100,7 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
     done = store.done(failed=not retry_failed)
     pending = np.array([i for i in range(n) if i not in done], dtype=np.int64)
 
-    mapper = resolve_runner(runner, retries=retries)
+    mapper = resolve_runner(runner, retries=retries, timeout=connect_timeout)
     task = Task(scene, k, layout, threads_per_worker, os.getpid())
     if not mapper.in_process:
         check_picklable(task)
