@@ -96,18 +96,17 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
             "sampler": repr(sampler), "kernel": _kernel_id(k), "inputs": layout.columns,
             "metrics": list(metrics) if metrics is not None else None,
             "tolerances": [repr(t) for t in layout.tolerances], "scene": json.loads(scene.to_json())}
-    store = open_store(out, meta, resume=resume)
-    done = store.done(failed=not retry_failed)
-    pending = np.array([i for i in range(n) if i not in done], dtype=np.int64)
-
-    mapper = resolve_runner(runner, retries=retries, timeout=connect_timeout)
     task = Task(scene, k, layout, threads_per_worker, os.getpid())
-    if not mapper.in_process:
-        check_picklable(task)
-    fn = functools.partial(evaluate_batch, task)
-    metric_names: list[str] | None = list(metrics) if metrics is not None else None
-    start = time.perf_counter()
+    mapper = resolve_runner(runner, retries=retries, timeout=connect_timeout)
     try:
+        if not mapper.in_process and not mapper.is_dask:  # Dask pickles with cloudpickle
+            check_picklable(task)
+        store = open_store(out, meta, resume=resume)
+        done = store.done(failed=not retry_failed)
+        pending = np.array([i for i in range(n) if i not in done], dtype=np.int64)
+        fn = functools.partial(evaluate_batch, task)
+        metric_names: list[str] | None = list(metrics) if metrics is not None else None
+        start = time.perf_counter()
         for c0 in range(0, len(pending), chunk_size):
             ids = pending[c0:c0 + chunk_size]
             batches = [[(int(i), x[i].tolist()) for i in ids[b:b + batch_size]] for b in range(0, len(ids), batch_size)]

@@ -145,7 +145,7 @@ class Mapper:
             futures = self.runner.map(fn, list(items), pure=False, retries=self.retries)
         from distributed import wait
 
-        wait(futures)
+        wait(futures)  # type: ignore[no-untyped-call, unused-ignore]
         done = [f for f in futures if f.status == "finished"]
         results = iter(self.runner.gather(done, errors="raise")) if done else iter(())
         out: list[Any] = []
