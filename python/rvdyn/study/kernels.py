@@ -69,7 +69,7 @@ class DynamicKernel:
         t0 = 0.2 * self.t_end if self.t_start is None else self.t_start
         i0 = min(int(np.searchsorted(t, t0)), len(t) - 2)
         w = slice(i0, None)
-        ratio = float(scene.ratio)
+        ratio = _ratio(scene)
         span = float(t[-1] - t[i0])
         mean_in = float(res.sun_angle[-1] - res.sun_angle[i0]) / span
         mean_out = float(res.carrier_angle[-1] - res.carrier_angle[i0]) / span
@@ -84,6 +84,20 @@ class DynamicKernel:
             "transmission_error_pp": float(np.ptp(te)),
             "peak_input_torque": float(np.max(np.abs(res.input_torque[w]))),
         }
+
+
+def _ratio(scene: Scene) -> float:
+    """Transmission ratio input speed / output speed of the scene."""
+    ratio = getattr(scene, "ratio", None)
+    if ratio is not None:
+        return float(ratio() if callable(ratio) else ratio)
+    from .._core import transmission_ratio
+
+    stage = scene["stage1"]
+    pins = int(scene["cycloid.pins"])
+    if stage is None:  # the input drives the cranks (as Scene.ratio): -(zp - 1) = -zc
+        return -float(pins - 1)
+    return float(transmission_ratio(int(stage["z_sun"]), int(stage["z_planet"]), pins))
 
 
 @dataclass(frozen=True)
