@@ -96,7 +96,7 @@ def _boot(x: np.ndarray, stat: Any, confidence: float, n_resamples: int, seed: i
     if len(x) < 2 or np.ptp(x) == 0:
         return Interval(value, value, value, confidence)
     res = stats.bootstrap((x,), stat, n_resamples=n_resamples, confidence_level=confidence, method="percentile",
-                          vectorized=True, batch=max(1, int(2e7 // max(len(x), 1))), **_rng_kw(stats.bootstrap, seed))
+                          vectorized=True, batch=max(1, int(2e6 // max(len(x), 1))), **_rng_kw(stats.bootstrap, seed))
     return Interval(value, float(res.confidence_interval.low), float(res.confidence_interval.high), confidence)
 
 
