@@ -75,24 +75,38 @@ def test_ray_pool_is_identical(reference: object) -> None:
 
 
 def dying_metric(scene: rvdyn.Scene) -> dict[str, float]:
-    """Kills its worker process for the largest d_rrp samples (a crashed worker)."""
-    if scene["cycloid.d_rrp"] > 2e-6:
+    """Kills its worker process for the largest d_rrp samples while the file named by
+    $RVDYN_TEST_DIE exists (a crashed worker)."""
+    marker = os.environ.get("RVDYN_TEST_DIE", "")
+    if scene["cycloid.d_rrp"] > 2e-6 and marker and os.path.exists(marker):
         os._exit(3)
     return {"y": scene["cycloid.d_rrp"], "threads": float(os.environ.get("RAYON_NUM_THREADS", "0"))}
 
 
-def test_a_dead_worker_is_recorded_not_dropped(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_dead_worker_is_recorded_not_dropped(monkeypatch: pytest.MonkeyPatch, tmp_path: os.PathLike[str]) -> None:
+    pytest.importorskip("pyarrow")
+    marker = os.path.join(tmp_path, "die")
+    open(marker, "w").close()
+    monkeypatch.setenv("RVDYN_TEST_DIE", marker)
     monkeypatch.delenv("RAYON_NUM_THREADS", raising=False)
+    out = os.path.join(tmp_path, "s.parquet")
     ctx = multiprocessing.get_context("spawn")
     tols = [Tolerance("cycloid.d_rrp", tol=1e-5)]
+    kernel = FunctionKernel(dying_metric, ("y", "threads"))
+    args = dict(samples=12, seed=0, out=out, chunk_size=4)
+    # The pool breaks when a worker dies; once it has lost a whole chunk the study stops.
     with concurrent.futures.ProcessPoolExecutor(2, mp_context=ctx) as ex:
-        t = rvdyn.study(SCENE, FunctionKernel(dying_metric, ("y", "threads")), tols, samples=12, seed=0,
-                        runner=ex, chunk_size=4)
-    assert list(t["sample"]) == list(range(12))
+        with pytest.raises(rvdyn.study.RunnerError, match="lost every task"):
+            rvdyn.study(SCENE, kernel, tols, runner=ex, **args)
+    t = rvdyn.study.read(out)
     dies = t["cycloid.d_rrp"] > 2e-6
-    assert dies.any()
+    assert len(t) >= 4 and dies.any()
+    assert list(t["sample"]) == list(range(len(t)))  # every attempted sample is a row
     assert t["error"][dies].str.startswith("runner failed").all()
-    ok = t["error"] == ""
-    # Samples that ran before the pool broke ran single-threaded.
-    assert ok.any() and (t["threads"][ok] == 1.0).all()
-    assert np.isnan(t["y"][~ok]).all()
+    assert np.isnan(t["y"][t["error"] != ""]).all()
+    # Resume with a working pool: the lost samples run again, none is missing.
+    os.remove(marker)
+    with concurrent.futures.ProcessPoolExecutor(2, mp_context=ctx) as ex:
+        t2 = rvdyn.study(SCENE, kernel, tols, runner=ex, retry_failed=True, **args)
+    assert list(t2["sample"]) == list(range(12)) and (t2["error"] == "").all()
+    assert (t2["threads"] == 1.0).all()  # workers ran single-threaded

@@ -29,7 +29,7 @@ from typing import Any
 from .driver import run
 from .kernels import DYNAMIC_METRICS, KERNELS, DynamicKernel, FunctionKernel, get_kernel, register_kernel
 from .plots import plot_histogram, plot_sensitivity
-from .runners import ThreadRunner, evaluate, evaluate_batch
+from .runners import RunnerError, ThreadRunner, evaluate, evaluate_batch
 from .sampling import LatinHypercube, MonteCarlo, design
 from .spec import Correlation, Criterion, Tolerance, expand
 from .stats import Interval, Sensitivity, YieldResult, describe, sobol, src, yield_rate
@@ -38,7 +38,7 @@ from .storage import read
 __all__ = [
     "run", "read", "Tolerance", "Correlation", "Criterion", "MonteCarlo", "LatinHypercube", "design", "expand",
     "DynamicKernel", "FunctionKernel", "KERNELS", "DYNAMIC_METRICS", "register_kernel", "get_kernel",
-    "ThreadRunner", "evaluate", "evaluate_batch", "describe", "yield_rate", "src", "sobol", "Interval",
+    "RunnerError", "ThreadRunner", "evaluate", "evaluate_batch", "describe", "yield_rate", "src", "sobol", "Interval",
     "YieldResult", "Sensitivity", "plot_histogram", "plot_sensitivity",
 ]
 

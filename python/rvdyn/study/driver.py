@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..scene import Scene
 from .kernels import get_kernel
-from .runners import Task, _Failure, check_picklable, evaluate_batch, resolve_runner
+from .runners import RunnerError, Task, _Failure, check_picklable, evaluate_batch, resolve_runner
 from .sampling import as_sampler, design
 from .spec import Correlation, Criterion, Tolerance, check_criteria, expand
 from .storage import _columns_of_records, open_store, to_table
@@ -122,6 +122,11 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
             for r in records:
                 metric_names += [m for m in r[1] if m not in metric_names]
             store.write(_columns_of_records(records, x[ids], layout.columns, metric_names))
+            if results and all(isinstance(r, _Failure) for r in results):
+                where = f"; the rows so far are in {str(out)!r}: run again to resume (retry_failed=True " \
+                        "reruns the lost samples)" if out is not None else ""
+                raise RunnerError(f"the runner lost every task of samples {int(ids[0])}..{int(ids[-1])} "
+                                  f"({results[0].message}){where}")
             if progress:
                 done_now = c0 + len(ids)
                 rate = done_now / max(time.perf_counter() - start, 1e-9)

@@ -27,11 +27,11 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, RvdynError
 from ..scene import Scene
 from .spec import Layout, apply_values
 
-__all__ = ["ThreadRunner", "Task", "Record", "evaluate", "evaluate_batch", "resolve_runner", "THREAD_ENV"]
+__all__ = ["RunnerError", "ThreadRunner", "Task", "Record", "evaluate", "evaluate_batch", "resolve_runner", "THREAD_ENV"]
 
 #: Environment variables set in worker processes so each worker runs single-threaded native
 #: code (rayon in the Rust core, BLAS/OpenMP in numpy): n workers use n cores, not n^2.
@@ -39,6 +39,12 @@ THREAD_ENV = ("RAYON_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "M
 
 #: One evaluated sample: (sample id, {metric: value}, error message or "").
 Record = tuple[int, dict[str, float], str]
+
+
+class RunnerError(RvdynError, RuntimeError):
+    """The runner lost every task of a chunk (a broken process pool, workers that keep dying):
+    the study stops. The rows so far (the lost ones with their error) are on disk when the study
+    has ``out``; running it again resumes (``retry_failed=True`` reruns the lost samples)."""
 
 
 @dataclass(frozen=True)
