@@ -43,9 +43,18 @@ def cheap(scene: rvdyn.Scene) -> dict[str, float]:
     return {"d_sum": scene["cycloid.d_rrp"] + scene["cycloid.d_rp"], "r_max": max(r), "r_min": min(r)}
 
 
-def _runners(workers: int) -> dict[str, tuple[Any, float, Any]]:
+class Serial:
+    """The samples one after the other in this process (the baseline of the overhead)."""
+
+    def map(self, fn: Any, items: Any) -> list[Any]:
+        return [fn(i) for i in items]
+
+
+def _runners(workers: int, serial: bool = False) -> dict[str, tuple[Any, float, Any]]:
     """name -> (runner, start-up seconds, closer)."""
     out: dict[str, tuple[Any, float, Any]] = {}
+    if serial:
+        out["serial"] = (Serial(), 0.0, lambda: None)
     out["threads"] = (workers, 0.0, lambda: None)
     t = time.perf_counter()
     ex = concurrent.futures.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
@@ -104,7 +113,7 @@ def part_dynamic(n: int, rounds: int, t_end: float) -> dict[str, Any]:
 
 def part_overhead(n: int, rounds: int) -> dict[str, Any]:
     res: dict[str, Any] = {}
-    runners = _runners(2)
+    runners = _runners(2, serial=True)
     for runner, _, _ in runners.values():  # imports (pandas, scipy) and first calls outside the timing
         _timed(runner, FunctionKernel(noop, ("y",)), 4, 0)
     cases = [(name, b) for name in runners for b in (1, 50)]
@@ -115,7 +124,8 @@ def part_overhead(n: int, rounds: int) -> dict[str, Any]:
     for name, b in cases:
         per = statistics.median(walls[(name, b)]) / n
         res[f"{name}/batch{b}"] = per
-        print(f"overhead, no-op kernel, 2 workers, {name:9s} batch {b:3d}: {per * 1e6:8.1f} us per sample", flush=True)
+        print(f"overhead, no-op kernel, {'1 (serial)' if name == 'serial' else '2 workers'}, {name:9s} batch {b:3d}: "
+              f"{per * 1e6:8.1f} us per sample", flush=True)
     for _, _, close in runners.values():
         close()
     return res

@@ -306,8 +306,9 @@ dir = "out"
 """)
     from rvdyn.cli import main
 
-    assert main(["study", spec, "--no-plots"]) == 0
+    assert main(["study", spec]) == 0
     out = os.path.join(tmp_path, "out")
+    assert os.path.getsize(os.path.join(out, "peak_pin_force.png")) > 0
     with open(os.path.join(out, "statistics.json"), encoding="utf-8") as f:
         stats = json.load(f)
     assert stats["samples"] == 4 and stats["yield"]["passed"] == 4

@@ -171,7 +171,8 @@ class Mapper:
         self._scattered = None
         if not self.owned:
             return
-        for name in ("shutdown", "close"):
+        # A Dask client is closed, never shut down (that would stop a shared cluster).
+        for name in (("close",) if self.is_dask else ("shutdown", "close")):
             method = getattr(self.runner, name, None)
             if method is not None:
                 method()
