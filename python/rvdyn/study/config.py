@@ -57,11 +57,11 @@ _SECTIONS = {"scene", "kernel", "sampling", "tolerances", "correlations", "crite
 
 
 def _toml(path: Path) -> dict[str, Any]:
-    try:
+    if sys.version_info >= (3, 11):
         import tomllib
-    except ImportError:  # Python 3.10
+    else:  # Python 3.10
         try:
-            import tomli as tomllib  # type: ignore[no-redef, import-not-found, unused-ignore]
+            import tomli as tomllib  # type: ignore[import-not-found, unused-ignore]
         except ImportError:
             raise ParameterError("reading spec.toml on Python 3.10 needs tomli: pip install tomli") from None
     try:
@@ -94,7 +94,7 @@ def _runner(d: dict[str, Any]) -> Any:
         if address:
             return str(address)
         try:
-            from distributed import Client, LocalCluster
+            from distributed import Client, LocalCluster  # type: ignore[import-untyped, import-not-found, unused-ignore]
         except ImportError:
             raise ParameterError("[runner] kind = 'dask' needs Dask: pip install 'rvdyn[dask]'") from None
         cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1,  # type: ignore[no-untyped-call, unused-ignore]

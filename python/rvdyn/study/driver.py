@@ -71,7 +71,7 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
     if not isinstance(scene, Scene):
         raise ParameterError(f"scene must be an rvdyn.Scene, got {type(scene).__name__}")
     try:
-        import scipy  # noqa: F401
+        import scipy  # type: ignore[import-untyped, import-not-found, unused-ignore]  # noqa: F401
     except ImportError:
         raise ImportError("rvdyn.study needs SciPy: pip install 'rvdyn[study]'") from None
     chunk_size = _positive("chunk_size", chunk_size)

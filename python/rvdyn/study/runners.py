@@ -149,7 +149,7 @@ class Mapper:
                                       retries=self.retries)
         else:
             futures = self.runner.map(fn, list(items), pure=False, retries=self.retries)
-        from distributed import wait
+        from distributed import wait  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
         wait(futures)  # type: ignore[no-untyped-call, unused-ignore]
         done = [f for f in futures if f.status == "finished"]
@@ -181,7 +181,7 @@ class Mapper:
 
 def _dask_client(address: str, timeout: float) -> Any:
     try:
-        from distributed import Client
+        from distributed import Client  # type: ignore[import-untyped, import-not-found, unused-ignore]
     except ImportError:
         raise ParameterError(f"runner {address!r} needs Dask: pip install 'rvdyn[dask]'") from None
     try:
@@ -192,8 +192,8 @@ def _dask_client(address: str, timeout: float) -> Any:
 
 def _ray_pool(address: str | None, workers: int | None) -> Any:
     try:
-        import ray
-        from ray.util.multiprocessing import Pool
+        import ray  # type: ignore[import-untyped, import-not-found, unused-ignore]
+        from ray.util.multiprocessing import Pool  # type: ignore[import-untyped, import-not-found, unused-ignore]
     except ImportError:
         raise ParameterError("runner 'ray' needs Ray: pip install 'rvdyn[ray]'") from None
     try:

@@ -56,7 +56,7 @@ class LatinHypercube:
 
     def uniforms(self, d: int, seed: int | None) -> np.ndarray:
         """Uniforms (n, d) in [0, 1)."""
-        from scipy.stats import qmc
+        from scipy.stats import qmc  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
         n = _count(self.n)
         rng = np.random.default_rng(seed)
@@ -87,7 +87,7 @@ def as_sampler(samples: Any) -> Any:
 
 def design(layout: Layout, sampler: Any, seed: int | None) -> np.ndarray:
     """Values (n, d) of every variable for every sample [field units], from the seed alone."""
-    from scipy.special import ndtr, ndtri
+    from scipy.special import ndtr, ndtri  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
         raise ParameterError(f"seed must be a non-negative integer (or None), got {seed!r}")

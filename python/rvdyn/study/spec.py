@@ -163,7 +163,7 @@ class Variable:
 
     def ppf(self, u: np.ndarray) -> np.ndarray:
         """Values [field units] for uniform quantiles ``u`` in (0, 1)."""
-        from scipy.special import ndtri
+        from scipy.special import ndtri  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
         if self.dist == "uniform":
             dev = self.lower + (self.upper - self.lower) * u
@@ -173,7 +173,7 @@ class Variable:
 
     def scipy_dist(self) -> Any:
         """The frozen scipy.stats distribution of this variable's value."""
-        from scipy import stats
+        from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
         if self.dist == "uniform":
             return stats.uniform(loc=self.nominal + self.lower, scale=self.upper - self.lower)

@@ -90,7 +90,7 @@ def _rng_kw(fn: Any, seed: int | None) -> dict[str, Any]:
 
 
 def _boot(x: np.ndarray, stat: Any, confidence: float, n_resamples: int, seed: int | None) -> Interval:
-    from scipy import stats
+    from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     value = float(stat(x, axis=-1))
     if len(x) < 2 or np.ptp(x) == 0:
@@ -145,7 +145,7 @@ def yield_rate(table: Any, criteria: Sequence[Criterion | dict[str, Any]], confi
     """Fraction of samples meeting all ``criteria`` with a binomial confidence interval:
     ``method="wilson"`` (score interval) or ``"exact"`` (Clopper-Pearson). Failed samples count
     as not passing."""
-    from scipy import stats
+    from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     if method not in ("wilson", "exact", "wilsoncc"):
         raise ParameterError(f"method must be 'wilson', 'wilsoncc' or 'exact', got {method!r}")
@@ -219,7 +219,7 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
     the same order) from a Saltelli design of ``n`` base samples (a power of 2): the kernel
     runs n (d + 2) times on ``runner``. Independent tolerances only; a failed sample makes the
     estimate NaN."""
-    from scipy import stats
+    from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     from .kernels import get_kernel
     from .runners import Task, _Failure, evaluate_batch, resolve_runner

@@ -29,7 +29,7 @@ META = "meta.json"
 
 def have_pandas() -> bool:
     try:
-        import pandas  # noqa: F401
+        import pandas  # type: ignore[import-untyped, import-not-found, unused-ignore]  # noqa: F401
     except ImportError:
         return False
     return True
@@ -67,7 +67,7 @@ class ParquetStore:
 
     def __init__(self, path: str | Path, meta: dict[str, Any], resume: bool = True):
         try:
-            import pyarrow  # noqa: F401
+            import pyarrow  # type: ignore[import-untyped, import-not-found, unused-ignore]  # noqa: F401
         except ImportError:
             raise ParameterError(f"out={str(path)!r}: writing a study needs pyarrow: pip install 'rvdyn[study]'") from None
         self.path = Path(path)
@@ -100,7 +100,7 @@ class ParquetStore:
 
     def done(self, failed: bool = True) -> set[int]:
         """Sample ids on disk (with ``failed=False``: only those that ran without error)."""
-        import pyarrow.parquet as pq
+        import pyarrow.parquet as pq  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
         ids: set[int] = set()
         latest: dict[int, bool] = {}
@@ -114,8 +114,8 @@ class ParquetStore:
         return ids
 
     def write(self, cols: dict[str, np.ndarray]) -> None:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
+        import pyarrow as pa  # type: ignore[import-untyped, import-not-found, unused-ignore]
+        import pyarrow.parquet as pq  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
         arrays = {k: (pa.array(v.tolist(), type=pa.string()) if k == "error" else pa.array(v)) for k, v in cols.items()}
         table = pa.table(arrays)
@@ -126,7 +126,7 @@ class ParquetStore:
         self._seq += 1
 
     def columns(self) -> dict[str, np.ndarray]:
-        import pyarrow.parquet as pq
+        import pyarrow.parquet as pq  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
         parts = []
         for p in self._parts():
@@ -172,7 +172,7 @@ def to_table(cols: dict[str, np.ndarray], as_numpy: bool = False, inputs: Sequen
     """A pandas DataFrame (when pandas is installed and not ``as_numpy``; ``attrs`` holds the
     ``inputs`` and ``metrics`` column names) or a numpy structured array, columns in order."""
     if not as_numpy and have_pandas():
-        import pandas as pd
+        import pandas as pd  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
         df = pd.DataFrame({k: (v.astype(str) if k == "error" else v) for k, v in cols.items()})
         if inputs is not None:
