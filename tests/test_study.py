@@ -317,3 +317,12 @@ dir = "out"
     with open(bad, "w", encoding="utf-8") as f:
         f.write('[[tolerances]]\npath = "cycloid.d_rrp"\ntol = -1.0\n')
     assert main(["study", bad]) == 1
+
+
+def test_statistics_of_a_numpy_table_match_the_dataframe() -> None:
+    a = rvdyn.study(SCENE, linear_metric, TOLS, samples=40, seed=2, as_numpy=True)
+    df = rvdyn.study(SCENE, linear_metric, TOLS, samples=40, seed=2)
+    assert rvdyn.study.src(a, "y") == rvdyn.study.src(df, "y")
+    crit = [Criterion("y", max=0.0)]
+    assert rvdyn.study.yield_rate(a, crit) == rvdyn.study.yield_rate(df, crit)
+    assert rvdyn.study.describe(a, n_resamples=100) == rvdyn.study.describe(df, n_resamples=100)
