@@ -186,3 +186,25 @@ def test_output_speed_ripple_is_at_the_pin_pass_frequency() -> None:
         near = np.abs(freq - h * f_pin) <= df
         assert spectrum[near].max() > 100 * background, h
     assert math.isfinite(float(spectrum.max()))
+
+
+def test_default_scene_approaches_at_rated_load() -> None:
+    # docs/model.md, Default scene and First-stage mesh: at the rated load each sun/planet mesh
+    # carries the input torque over three base radii (about 10.1 kN) at an approach of about
+    # 86 um of the paper's IMPACT law, x = (F/k)^(1/1.5); the most loaded pin (about 35.5 kN)
+    # penetrates about 199 um. References: the lossless torque split and the law's inverse;
+    # 1 % (the mean over [0.1, 0.3] s carries a little ripple and the contact-damping loss).
+    scene = rvdyn.Scene.paper("rated")
+    res = rvdyn.simulate(scene, 0.3, channels=["pins", "mesh"])
+    i0 = int(np.searchsorted(res.t, 0.1))
+    r_bs = rvdyn.InvoluteStage.paper().sun_base_radius
+    op = rvdyn.operating_point(112e3, rvdyn.rad_s(8328.0), 57.0)
+    force = float(res.mesh_force[i0:].mean())
+    assert force == pytest.approx(op.input_torque / (3 * r_bs), rel=0.01)
+    k = rvdyn.PAPER_IMPACT_STIFFNESS
+    assert float(res.mesh_deflection[i0:].mean()) == pytest.approx((force / k) ** (1 / 1.5), rel=0.01)
+    assert float(res.mesh_deflection[i0:].mean()) == pytest.approx(86e-6, rel=0.01)
+    f_max = float(res.pin_force[i0:].max())
+    assert f_max == pytest.approx(35.5e3, rel=0.01)
+    assert float(res.pin_penetration[i0:].max()) == pytest.approx((f_max / k) ** (1 / 1.5), rel=0.01)
+    assert float(res.pin_penetration[i0:].max()) == pytest.approx(199e-6, rel=0.01)
