@@ -115,7 +115,8 @@ def _anchor(title: str) -> str:
 
 def _anchors(path: Path) -> set[str]:
     text = re.sub(r"```.*?```", "", path.read_text(encoding="utf-8"), flags=re.DOTALL)
-    return {_anchor(m.group(1)) for m in re.finditer(r"^#+\s+(.*)$", text, re.MULTILINE)}
+    headings = {_anchor(m.group(1)) for m in re.finditer(r"^#+\s+(.*)$", text, re.MULTILINE)}
+    return headings | set(re.findall(r'<a id="([^"]+)"></a>', text))
 
 
 DOC_FILES = sorted(DOCS.glob("*.md")) + [ROOT / "README.md"]
@@ -142,6 +143,8 @@ def test_model_has_the_sections_others_link_to() -> None:
                     "kinematics-and-operating-point", "energy-accounting", "integrators",
                     "errata-of-the-paper", "default-scene", "excitation-orders"):
         assert section in anchors, section
+    for n in range(1, 12):
+        assert f"erratum-{n}" in anchors, n
 
 
 def test_docs_cite_nothing_outside_the_repository() -> None:
