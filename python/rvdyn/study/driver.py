@@ -125,8 +125,12 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
             if results and all(isinstance(r, _Failure) for r in results):
                 where = f"; the rows so far are in {str(out)!r}: run again to resume (retry_failed=True " \
                         "reruns the lost samples)" if out is not None else ""
+                hint = ""
+                if "BrokenProcessPool" in results[0].message:
+                    hint = ("; a process pool also breaks when the main script lacks "
+                            "`if __name__ == '__main__':` (worker processes import it)")
                 raise RunnerError(f"the runner lost every task of samples {int(ids[0])}..{int(ids[-1])} "
-                                  f"({results[0].message}){where}")
+                                  f"({results[0].message}){where}{hint}")
             if progress:
                 done_now = c0 + len(ids)
                 rate = done_now / max(time.perf_counter() - start, 1e-9)
