@@ -89,43 +89,50 @@ def _rng_kw(fn: Any, seed: int | None) -> dict[str, Any]:
     return {key: np.random.default_rng(seed)}
 
 
-def _boot(x: np.ndarray, stat: Any, confidence: float, n_resamples: int, seed: int | None) -> Interval:
-    from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
-
-    value = float(stat(x, axis=-1))
-    if len(x) < 2 or np.ptp(x) == 0:
-        return Interval(value, value, value, confidence)
-    res = stats.bootstrap((x,), stat, n_resamples=n_resamples, confidence_level=confidence, method="percentile",
-                          vectorized=True, batch=max(1, int(2e6 // max(len(x), 1))), **_rng_kw(stats.bootstrap, seed))
-    return Interval(value, float(res.confidence_interval.low), float(res.confidence_interval.high), confidence)
+def _summary_stat(qs: Sequence[float]) -> Any:
+    def stat(a: np.ndarray, axis: int = -1) -> np.ndarray:
+        n = a.shape[axis]
+        std = np.std(a, axis=axis, ddof=1) if n > 1 else np.zeros(np.delete(a.shape, axis))
+        return np.stack([np.mean(a, axis=axis), std, *np.percentile(a, list(qs), axis=axis)])
+    return stat
 
 
 def describe(table: Any, metrics: Sequence[str] | None = None, percentiles: Sequence[float] = (5.0, 50.0, 95.0),
              confidence: float = 0.95, n_resamples: int = 1000, seed: int | None = 0) -> dict[str, dict[str, Any]]:
-    """Per metric: ``n`` (samples that ran), ``failed``, ``mean``, ``std`` and each
-    percentile ``"p<q>"`` as :class:`Interval` s (percentile bootstrap, ``n_resamples``)."""
+    """Per metric: ``n`` (samples that ran), ``failed``, ``mean``, ``std`` (ddof 1) and each
+    percentile ``"p<q>"`` as :class:`Interval` s: percentile bootstrap intervals, all
+    statistics from the same ``n_resamples`` resamples."""
+    from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
+
     cols = columns(table)
     if not 0 < confidence < 1:
         raise ParameterError(f"confidence must lie in (0, 1), got {confidence}")
     for q in percentiles:
         if not 0 <= q <= 100:
             raise ParameterError(f"percentiles must lie in [0, 100], got {q}")
+    if isinstance(n_resamples, bool) or not isinstance(n_resamples, int) or n_resamples < 1:
+        raise ParameterError(f"n_resamples must be a positive integer, got {n_resamples!r}")
     names = list(metrics) if metrics is not None else metric_names(table)
+    keys = ["mean", "std"] + [f"p{q:g}" for q in percentiles]
+    stat = _summary_stat(percentiles)
     out: dict[str, dict[str, Any]] = {}
     for name in names:
         v = _metric(cols, name)
         x = v[np.isfinite(v)]
         entry: dict[str, Any] = {"n": int(len(x)), "failed": int(len(v) - len(x))}
-        if len(x) == 0:
-            out[name] = entry
-            continue
-        entry["mean"] = _boot(x, np.mean, confidence, n_resamples, seed)
-        entry["std"] = _boot(x, lambda a, axis: np.std(a, axis=axis, ddof=1) if a.shape[-1] > 1 else np.zeros(a.shape[:-1]),
-                             confidence, n_resamples, seed)
-        for q in percentiles:
-            entry[f"p{q:g}"] = _boot(x, lambda a, axis, q=q: np.percentile(a, q, axis=axis), confidence,
-                                     n_resamples, seed)
         out[name] = entry
+        if len(x) == 0:
+            continue
+        value = stat(x)
+        if len(x) < 2 or np.ptp(x) == 0:
+            low = high = value
+        else:
+            res = stats.bootstrap((x,), stat, n_resamples=n_resamples, confidence_level=confidence,
+                                  method="percentile", vectorized=True, batch=max(1, int(2e6 // len(x))),
+                                  **_rng_kw(stats.bootstrap, seed))
+            low, high = np.asarray(res.confidence_interval.low), np.asarray(res.confidence_interval.high)
+        for k, key in enumerate(keys):
+            entry[key] = Interval(float(value[k]), float(low[k]), float(high[k]), confidence)
     return out
 
 
