@@ -92,14 +92,13 @@ def design(layout: Layout, sampler: Any, seed: int | None) -> np.ndarray:
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
         raise ParameterError(f"seed must be a non-negative integer (or None), got {seed!r}")
     d = len(layout.variables)
-    u = np.asarray(sampler.uniforms(d, seed), dtype=float)
+    u: np.ndarray = np.array(sampler.uniforms(d, seed), dtype=float)
     if u.ndim != 2 or u.shape[1] != d or not np.all((u >= 0) & (u <= 1)):
         raise ParameterError(f"sampler {sampler!r} must give uniforms in [0, 1] of shape (n, {d})")
-    u = np.clip(u, _EPS, 1.0 - _EPS)
+    np.clip(u, _EPS, 1.0 - _EPS, out=u)
     for cols, chol in layout.groups:
         z = ndtri(u[:, cols])
         u[:, cols] = np.clip(ndtr(z @ chol.T), _EPS, 1.0 - _EPS)
-    out: np.ndarray = np.empty_like(u)
-    for j, var in enumerate(layout.variables):
-        out[:, j] = var.ppf(u[:, j])
-    return out
+    for j, var in enumerate(layout.variables):  # in place: the design is the largest array of a study
+        u[:, j] = var.ppf(u[:, j])
+    return u
