@@ -199,7 +199,8 @@ def test_sweep_runs_a_grid_and_reports_failures() -> None:
     peaks = [o.pin_force.max() for o in out]
     assert peaks[1] > peaks[0]
     bad = rvdyn.sweep([base, base], 0.05, "rk4", dt=5e-4, channels=["pins"])
-    assert all(isinstance(b, rvdyn.SimulationError) for b in bad)
+    # Issue 7: sweep returns Result objects with ok/error (it returned the exceptions).
+    assert all(not b.ok and isinstance(b.error, rvdyn.SimulationError) for b in bad)
 
 
 def test_ctrl_c_stops_a_run_cleanly() -> None:

@@ -5,7 +5,7 @@ float, a sequence or a numpy array; functions marked "broadcast" combine their a
 with numpy's broadcasting rules and return a float when every array argument is a scalar.
 """
 
-from typing import Any, Union
+from typing import Any, Sequence, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -277,57 +277,125 @@ def body_speeds(
 def operating_point(power: float, input_speed: float, ratio: float) -> OperatingPoint:
     """Lossless operating point for power [W], input speed [rad/s] and ratio [-]."""
 
-# ---- scenes and dynamic runs (rust/python/simulate.rs; wrapped by rvdyn.Scene, rvdyn.simulate,
-# rvdyn.sweep and rvdyn.Result: use those) ----------------------------------------------------
+# ---- scenes and dynamic runs (rust/python/scene.rs, rust/python/simulate.rs; wrapped by
+# rvdyn.Scene, rvdyn.simulate, rvdyn.sweep and rvdyn.Result: use those) -----------------------
 
-def scene_paper(load: str) -> str:
-    """The default scene as JSON; load is "idle", "paper" or "rated"."""
+@final
+class CompiledScene:
+    """A validated scene held by the core (immutable); ``rvdyn.Scene`` wraps it."""
 
-def scene_validate(json: str) -> str:
-    """Validate a scene given as JSON; returns it normalised (defaults filled in) as JSON."""
-
-def scene_to_toml(json: str) -> str:
-    """Scene JSON -> TOML text."""
-
-def scene_from_toml(text: str) -> str:
-    """TOML text -> validated scene JSON."""
-
-def scene_model_info(json: str) -> dict[str, Any]:
-    """Mass properties [kg, kg m^2] and generalised masses the model uses for a scene (SI),
-    crank radius [m], ratio, number of free coordinates (dof) and joint kind."""
+    @staticmethod
+    def from_json(text: str) -> CompiledScene:
+        """Validate a scene given as JSON text (unknown fields are errors)."""
+    @staticmethod
+    def from_toml(text: str) -> CompiledScene:
+        """Validate a scene given as TOML text."""
+    @staticmethod
+    def paper(load: str) -> CompiledScene:
+        """The default scene; load is "idle", "paper" or "rated"."""
+    def to_json(self, indent: bool = True) -> str:
+        """The scene as JSON text."""
+    def to_toml(self) -> str:
+        """The scene as TOML text."""
+    def get(self, path: str) -> str:
+        """The value at a dotted field path, as JSON text."""
+    def replace(self, changes: list[tuple[str, str]]) -> CompiledScene:
+        """A new validated scene with (dotted path, JSON value) changes."""
+    def model_info(self) -> dict[str, Any]:
+        """Mass properties [kg, kg m^2] and generalised masses the model uses (SI), crank radius
+        [m], ratio, number of free coordinates (dof) and joint kind."""
+    def __eq__(self, other: object) -> bool: ...
+    def __hash__(self) -> int: ...
 
 def default_compliant_joints() -> str:
     """The default compliant joints (assumed bearing stiffness [N/m] and damping [N s/m]) as JSON."""
 
+@final
+class Options:
+    """Options of a dynamic run (all but the end time), validated when built; None = default.
+
+    integrator: "generalized-alpha" (default), "dopri5" or "rk4"; dt [s] (None = the
+    integrator's default: 1e-4, 1e-6 (initial), 1e-5 s); rtol (adaptive, velocities, default
+    1e-6); atol [m] (displacement tolerance, default 1e-9 m); rho_inf in [0, 1] (default 0.8);
+    record_interval [s] (None = 1e-4 s); max_samples (default 50 000); channels (groups:
+    "motion", "pins", "contact_points", "mesh", "energy"; None = all but contact points);
+    skip_separated (default True).
+    """
+
+    def __new__(
+        cls,
+        integrator: str | None = None,
+        *,
+        dt: float | None = None,
+        rtol: float | None = None,
+        atol: float | None = None,
+        rho_inf: float | None = None,
+        record_interval: float | None = None,
+        max_samples: int | None = None,
+        channels: Sequence[str] | str | None = None,
+        skip_separated: bool | None = None,
+    ) -> Options: ...
+    def replace(
+        self,
+        *,
+        integrator: str | None = None,
+        dt: float | None = None,
+        rtol: float | None = None,
+        atol: float | None = None,
+        rho_inf: float | None = None,
+        record_interval: float | None = None,
+        max_samples: int | None = None,
+        channels: Sequence[str] | str | None = None,
+        skip_separated: bool | None = None,
+    ) -> Options:
+        """A copy with the options given (not None) changed."""
+    @property
+    def integrator(self) -> str:
+        """Integrator name."""
+    @property
+    def dt(self) -> float | None:
+        """Step [s] (initial step of an adaptive method); None = the integrator's default."""
+    @property
+    def rtol(self) -> float:
+        """Relative velocity tolerance of the adaptive method."""
+    @property
+    def atol(self) -> float:
+        """Displacement tolerance [m]."""
+    @property
+    def rho_inf(self) -> float:
+        """Spectral radius at infinite frequency of generalized-alpha."""
+    @property
+    def record_interval(self) -> float | None:
+        """Sample interval [s]; None = 1e-4 s."""
+    @property
+    def max_samples(self) -> int:
+        """Most samples kept."""
+    @property
+    def channels(self) -> list[str]:
+        """Channel groups recorded."""
+    @property
+    def skip_separated(self) -> bool:
+        """Whether pins that provably cannot touch skip the exact gap query."""
+    def to_dict(self) -> dict[str, Any]:
+        """The options as a dict of constructor arguments."""
+    def resolved(self, t_end: float) -> dict[str, Any]:
+        """The options a run to t_end [s] actually uses (step and sample interval resolved)."""
+    def __reduce__(self) -> tuple[Any, tuple[dict[str, Any]]]: ...
+    def __eq__(self, other: object) -> bool: ...
+
+def integrators() -> list[tuple[str, str, float, bool]]:
+    """The registered integrators: (name, summary, default step [s], adaptive)."""
+
+def channels() -> list[dict[str, Any]]:
+    """The channel registry: name, group, shape (dimension names), unit, dtype, doc per channel."""
+
 def simulate(
-    scene_json: str,
-    t_end: float,
-    integrator: str,
-    dt: float | None = None,
-    rtol: float | None = None,
-    atol: float | None = None,
-    rho_inf: float | None = None,
-    record_interval: float | None = None,
-    max_samples: int | None = None,
-    channels: list[str] | None = None,
-    progress: bool = False,
-    skip_separated: bool = True,
-) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Run one scene for t_end [s]; returns (recorded numpy arrays, run statistics).
-    skip_separated: do not query pins that provably cannot touch (same answer, less work)."""
+    scene: CompiledScene, t_end: float, options: Options, progress: bool = False
+) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
+    """Run one scene for t_end [s]; returns (recorded numpy arrays, run statistics)."""
 
 def sweep(
-    scene_jsons: list[str],
-    t_end: float,
-    integrator: str,
-    dt: float | None = None,
-    rtol: float | None = None,
-    atol: float | None = None,
-    rho_inf: float | None = None,
-    record_interval: float | None = None,
-    max_samples: int | None = None,
-    channels: list[str] | None = None,
-    threads: int | None = None,
-    skip_separated: bool = True,
-) -> list[tuple[dict[str, Any], dict[str, Any]] | BaseException]:
-    """Run many scenes in parallel; per scene (arrays, statistics) or the exception it raised."""
+    scenes: list[CompiledScene], t_end: float, options: Options, threads: int | None = None
+) -> list[tuple[dict[str, NDArray[Any]], dict[str, Any]] | BaseException]:
+    """Run many scenes in parallel; per scene (arrays, statistics) or the exception it raised.
+    Ctrl-C stops every run (KeyboardInterrupt)."""

@@ -357,10 +357,28 @@ impl Scene {
 
     /// Parse a scene from JSON text.
     pub fn from_json(text: &str) -> Result<Self> {
-        let s: Scene = serde_json::from_str(text)
-            .map_err(|e| RvdynError::Scene(format!("invalid scene JSON: {e}")))?;
+        let v: serde_json::Value = serde_json::from_str(text)
+            .map_err(|e| RvdynError::Scene(format!("scene text is not valid JSON: {e}")))?;
+        Self::from_value(&v)
+    }
+
+    /// Build and validate a scene from a JSON tree. Every key of the tree must be a field of
+    /// the schema: an unknown one (a typo, or a field of another `kind`) is a `Scene` error
+    /// naming its path, in internally tagged enums too (where serde's `deny_unknown_fields`
+    /// does not reach).
+    pub fn from_value(v: &serde_json::Value) -> Result<Self> {
+        let s: Scene = serde_json::from_value(v.clone())
+            .map_err(|e| RvdynError::Scene(format!("invalid scene: {e}")))?;
+        let normal = s.to_value()?;
+        unknown_fields(v, &normal, "")?;
         s.validate()?;
         Ok(s)
+    }
+
+    /// The scene as a JSON tree (every field present, `null` for an absent optional one).
+    pub fn to_value(&self) -> Result<serde_json::Value> {
+        serde_json::to_value(self)
+            .map_err(|e| RvdynError::Scene(format!("scene cannot be written as JSON: {e}")))
     }
 
     /// Serialise to pretty JSON.
@@ -371,16 +389,25 @@ impl Scene {
 
     /// Parse a scene from TOML text.
     pub fn from_toml(text: &str) -> Result<Self> {
-        let s: Scene = toml::from_str(text)
-            .map_err(|e| RvdynError::Scene(format!("invalid scene TOML: {e}")))?;
-        s.validate()?;
-        Ok(s)
+        let v: serde_json::Value = toml::from_str(text)
+            .map_err(|e| RvdynError::Scene(format!("scene text is not valid TOML: {e}")))?;
+        Self::from_value(&v)
     }
 
     /// Serialise to TOML.
     pub fn to_toml(&self) -> Result<String> {
         toml::to_string(self)
             .map_err(|e| RvdynError::Scene(format!("scene cannot be written as TOML: {e}")))
+    }
+
+    /// A new validated scene with fields changed: `changes` maps dotted paths (list indices as
+    /// numbers: `"discs.1.d_rrp"`) to JSON values; a whole sub-tree may be replaced.
+    pub fn replace(&self, changes: &[(String, serde_json::Value)]) -> Result<Self> {
+        let mut tree = self.to_value()?;
+        for (path, value) in changes {
+            set_path(&mut tree, path, value.clone())?;
+        }
+        Self::from_value(&tree)
     }
 
     /// Check the scene as a whole; errors say which field is wrong and how to fix it.
@@ -577,6 +604,95 @@ impl Scene {
     }
 }
 
+/// The value at dotted `path` of a scene tree.
+pub fn get_path<'a>(tree: &'a serde_json::Value, path: &str) -> Result<&'a serde_json::Value> {
+    let mut node = tree;
+    for key in path_keys(path)? {
+        node = match node {
+            serde_json::Value::Object(m) => m.get(key),
+            serde_json::Value::Array(a) => key.parse::<usize>().ok().and_then(|i| a.get(i)),
+            _ => None,
+        }
+        .ok_or_else(|| RvdynError::Scene(format!("scene has no field {path:?} (at {key:?})")))?;
+    }
+    Ok(node)
+}
+
+fn path_keys(path: &str) -> Result<Vec<&str>> {
+    if path.is_empty() || path.split('.').any(str::is_empty) {
+        return Err(RvdynError::Scene(format!(
+            "a scene field path must be a non-empty dotted path like \"load.torque\", got {path:?}"
+        )));
+    }
+    Ok(path.split('.').collect())
+}
+
+/// Set the value at dotted `path` (the parent must exist; the last key must be a field of an
+/// object, or an index inside a list).
+fn set_path(tree: &mut serde_json::Value, path: &str, value: serde_json::Value) -> Result<()> {
+    let keys = path_keys(path)?;
+    let (last, parents) = keys.split_last().expect("non-empty path");
+    let missing = || RvdynError::Scene(format!("scene has no field {path:?}"));
+    let mut node = tree;
+    for key in parents {
+        node = match node {
+            serde_json::Value::Object(m) => m.get_mut(*key),
+            serde_json::Value::Array(a) => key.parse::<usize>().ok().and_then(|i| a.get_mut(i)),
+            _ => None,
+        }
+        .ok_or_else(|| RvdynError::Scene(format!("scene has no field {path:?} (at {key:?})")))?;
+    }
+    match node {
+        serde_json::Value::Object(m) => {
+            m.insert((*last).to_string(), value);
+        }
+        serde_json::Value::Array(a) => {
+            let slot = last
+                .parse::<usize>()
+                .ok()
+                .and_then(|i| a.get_mut(i))
+                .ok_or_else(missing)?;
+            *slot = value;
+        }
+        _ => return Err(missing()),
+    }
+    Ok(())
+}
+
+/// First key of `given` that the schema dropped when `normal` was written back.
+fn unknown_fields(given: &serde_json::Value, normal: &serde_json::Value, at: &str) -> Result<()> {
+    use serde_json::Value;
+    match (given, normal) {
+        (Value::Object(g), Value::Object(n)) => {
+            for (k, gv) in g {
+                let path = if at.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{at}.{k}")
+                };
+                match n.get(k) {
+                    Some(nv) => unknown_fields(gv, nv, &path)?,
+                    None => {
+                        let known: Vec<&str> = n.keys().map(String::as_str).collect();
+                        return Err(RvdynError::Scene(format!(
+                            "unknown scene field {path:?}; the fields here are {}",
+                            known.join(", ")
+                        )));
+                    }
+                }
+            }
+            Ok(())
+        }
+        (Value::Array(g), Value::Array(n)) => {
+            for (i, (gv, nv)) in g.iter().zip(n).enumerate() {
+                unknown_fields(gv, nv, &format!("{at}.{i}"))?;
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
 /// The paper's first stage: 18/42 teeth, 3 planets, module 3 mm, 20 deg, face 30 mm.
 fn paper_stage1() -> Result<InvoluteStage> {
     InvoluteStage::new(18, 42, 3, 3e-3, 20f64.to_radians(), 0.030)
@@ -624,6 +740,49 @@ mod tests {
             Load::Constant { torque } => assert!((torque - 43_923.0).abs() < 5.0, "{torque}"),
             _ => panic!(),
         }
+    }
+
+    #[test]
+    fn unknown_fields_are_rejected_in_tagged_enums_too() {
+        // Issue 12 D11: serde's deny_unknown_fields does not reach internally tagged enums.
+        let base = Scene::paper("idle").unwrap();
+        for (path, value) in [
+            (
+                "load",
+                r#"{"kind": "constant", "torque": 1.0, "torqe": 2.0}"#,
+            ),
+            ("load", r#"{"kind": "idle", "torque": 5.0}"#),
+            ("joints", r#"{"kind": "rigid", "stiffness": 1e9}"#),
+            (
+                "inertias.sun",
+                r#"{"mass": 1.0, "inertia": 1.0, "mas": 2.0}"#,
+            ),
+            (
+                "contact.pin",
+                r#"{"kind": "palmgren", "max_damping": 1.0, "damping_depth": 1e-5, "stiffness": 1.0}"#,
+            ),
+            ("drive.spede", "1.0"),
+        ] {
+            let v: serde_json::Value = serde_json::from_str(value).unwrap();
+            let err = base.replace(&[(path.to_string(), v)]).unwrap_err();
+            assert!(
+                matches!(err, RvdynError::Scene(_)) && err.to_string().contains("unknown"),
+                "{path}: {err}"
+            );
+        }
+        // A known field through the same path works.
+        let v = serde_json::json!({"kind": "constant", "torque": 1.0});
+        let s = base.replace(&[("load".into(), v)]).unwrap();
+        assert_eq!(s.load, Load::Constant { torque: 1.0 });
+        let s = s
+            .replace(&[("discs.1.d_rrp".into(), serde_json::json!(2e-5))])
+            .unwrap();
+        assert_eq!(s.discs[1].d_rrp, Some(2e-5));
+        assert!(
+            s.replace(&[("discs.2.d_rrp".into(), serde_json::json!(1.0))])
+                .is_err()
+        );
+        assert!(s.replace(&[("".into(), serde_json::json!(1.0))]).is_err());
     }
 
     #[test]
