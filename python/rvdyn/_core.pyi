@@ -14,6 +14,34 @@ from ._types import GapResult, LineContact, OperatingPoint
 
 _FloatOrArray = Union[float, NDArray[np.float64]]
 
+__all__ = [
+    "__version__",
+    "CycloidGeometry",
+    "InvoluteStage",
+    "contact_stiffness",
+    "stiffness_maximum",
+    "hertz_line_contact",
+    "impact_force",
+    "PAPER_IMPACT_STIFFNESS",
+    "PAPER_IMPACT_EXPONENT",
+    "PAPER_IMPACT_MAX_DAMPING",
+    "PAPER_IMPACT_DEPTH",
+    "PAPER_STIFFNESS_R1",
+    "PAPER_STIFFNESS_R2",
+    "transmission_ratio",
+    "body_speeds",
+    "operating_point",
+    "PAPER_PRINTED_OUTPUT_TORQUE",
+    "CompiledScene",
+    "default_compliant_joints",
+    "Options",
+    "options_from_dict",
+    "integrators",
+    "channels",
+    "simulate",
+    "sweep",
+]
+
 __version__: str
 
 PAPER_IMPACT_STIFFNESS: float
@@ -32,6 +60,7 @@ PAPER_PRINTED_OUTPUT_TORQUE: float
 """The output torque printed in the paper, 4024.9 N m: inconsistent with its 112 kW (it is
 10.3 kW at the output speed); the lossless value is 43.92 kN m."""
 
+@final
 class CycloidGeometry:
     """A validated cycloid disc and its pin ring (SI units: m, rad).
 
@@ -44,8 +73,8 @@ class CycloidGeometry:
     non-positive sizes.
     """
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         pins: int,
         eccentricity: float,
         pin_circle_radius: float,
@@ -54,7 +83,7 @@ class CycloidGeometry:
         d_rp: float = 0.0,
         d_rrp: float = 0.0,
         d_delta: float = 0.0,
-    ) -> None: ...
+    ) -> CycloidGeometry: ...
     @classmethod
     def paper(cls) -> CycloidGeometry:
         """The paper's default disc: zp 24, e 4.5 mm (given); rp 150 mm, rrp 10 mm, face 40 mm
@@ -129,6 +158,7 @@ class CycloidGeometry:
         default holes, for a density [kg/m^3]."""
     def __reduce__(self) -> tuple[Any, ...]: ...
 
+@final
 class InvoluteStage:
     """The involute first stage (sun and equally spaced planets; SI units).
 
@@ -139,8 +169,8 @@ class InvoluteStage:
     ParameterError (non-finite or non-positive sizes, pressure angle out of range).
     """
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         z_sun: int,
         z_planet: int,
         planets: int,
@@ -148,7 +178,7 @@ class InvoluteStage:
         pressure_angle: float,
         face_width: float,
         backlash: float = 0.0,
-    ) -> None: ...
+    ) -> InvoluteStage: ...
     @classmethod
     def paper(cls) -> InvoluteStage:
         """The paper's stage: 18/42 teeth, 3 planets (given); module 3 mm, 20 deg, face 30 mm
@@ -304,7 +334,7 @@ class CompiledScene:
     def model_info(self) -> dict[str, Any]:
         """Mass properties [kg, kg m^2] and generalised masses the model uses (SI), crank radius
         [m], ratio, number of free coordinates (dof) and joint kind."""
-    def __eq__(self, other: object) -> bool: ...
+    def __eq__(self, value: object, /) -> bool: ...
     def __hash__(self) -> int: ...
 
 def default_compliant_joints() -> str:
@@ -381,7 +411,10 @@ class Options:
     def resolved(self, t_end: float) -> dict[str, Any]:
         """The options a run to t_end [s] actually uses (step and sample interval resolved)."""
     def __reduce__(self) -> tuple[Any, tuple[dict[str, Any]]]: ...
-    def __eq__(self, other: object) -> bool: ...
+    def __eq__(self, value: object, /) -> bool: ...
+
+def options_from_dict(d: dict[str, Any]) -> Options:
+    """Rebuild options from Options.to_dict() (used by pickle)."""
 
 def integrators() -> list[tuple[str, str, float, bool]]:
     """The registered integrators: (name, summary, default step [s], adaptive)."""

@@ -162,7 +162,10 @@ class Result:
         k = i0 + int(np.nonzero(remaining >= target)[0][-1])
         sign = math.copysign(1.0, rel[-1] - rel[i0])
         lo, hi = float(t[k]), float(t[min(k + 1, len(t) - 1)])
-        f = lambda x: sign * (rel[-1] - _hermite(x, t, rel, rel_speed)) - target  # noqa: E731
+
+        def f(x: float) -> float:
+            return float(sign * (rel[-1] - _hermite(x, t, rel, rel_speed)) - target)
+
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             if f(mid) >= 0:
@@ -221,7 +224,8 @@ class Result:
             meta = json.dumps({"stats": self.stats, "scene": self.scene, "options": self.options}, allow_nan=False)
         except ValueError as exc:
             raise ParameterError(f"result metadata is not finite JSON: {exc}") from None
-        np.savez_compressed(p, __meta__=np.array(meta), **self._arrays)
+        arrays: dict[str, Any] = {"__meta__": np.array(meta), **self._arrays}
+        np.savez_compressed(p, **arrays)
         return p if p.suffix == ".npz" else p.with_name(p.name + ".npz")
 
     @classmethod

@@ -12,14 +12,13 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any, Literal, NoReturn, final
+from typing import Any, NoReturn, final
 
 from . import _core
 from .errors import SceneError
 
 __all__ = ["Scene"]
 
-LoadCase = Literal["idle", "paper", "rated"]
 
 
 def _json_value(path: str, value: Any) -> str:
@@ -68,7 +67,7 @@ class Scene:
 
     # ------------------------------------------------------------------ construction
     @classmethod
-    def paper(cls, load: LoadCase = "paper", /, **changes: Any) -> Scene:
+    def paper(cls, load: str = "paper", /, **changes: Any) -> Scene:
         """The default scene (``docs/model.md#default-scene``) at 8328 deg/s with a step start
         from rest.
 

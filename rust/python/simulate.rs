@@ -269,7 +269,7 @@ impl Options {
         &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>,))> {
-        let rebuild = py.import("rvdyn._core")?.getattr("_options_from_dict")?;
+        let rebuild = py.import("rvdyn._core")?.getattr("options_from_dict")?;
         Ok((rebuild, (self.to_dict(py)?,)))
     }
 
@@ -298,7 +298,7 @@ impl Options {
 
 /// Rebuild options from `Options.to_dict()` (used by pickle).
 #[pyfunction]
-fn _options_from_dict(d: &Bound<'_, PyDict>) -> PyResult<Options> {
+fn options_from_dict(d: &Bound<'_, PyDict>) -> PyResult<Options> {
     apply(SimOptions::new(1.0, Method::GeneralizedAlpha), Some(d))
 }
 
@@ -521,7 +521,7 @@ fn sweep<'py>(
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Options>()?;
-    m.add_function(wrap_pyfunction!(_options_from_dict, m)?)?;
+    m.add_function(wrap_pyfunction!(options_from_dict, m)?)?;
     m.add_function(wrap_pyfunction!(integrators, m)?)?;
     m.add_function(wrap_pyfunction!(channels, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
