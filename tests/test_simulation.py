@@ -28,7 +28,7 @@ def rated_run() -> Result:
 
 
 def test_mean_output_speed_is_input_over_57(rated_run: Result) -> None:
-    # A gear train cannot slip (design.md erratum 5): over whole crank revolutions the mean
+    # A gear train cannot slip (docs/model.md#errata-of-the-paper, erratum 5): over whole crank revolutions the mean
     # output speed equals input/57 up to the change of elastic deflection, ~1e-9 here. The
     # contract is 1e-4 relative; the paper's 0.83 % would fail by a factor of 80.
     mean = rated_run.mean_output_speed(0.1)
@@ -61,7 +61,7 @@ def test_result_shapes_and_units(rated_run: Result) -> None:
 
 
 def test_pin_forces_follow_classical_load_sharing() -> None:
-    # notes/physics.md 2.1: with a linear contact law (exponent 1) and an unmodified profile,
+    # docs/validation.md: with a linear contact law (exponent 1) and an unmodified profile,
     # the penetration of pin i is proportional to its lever l_i about the disc centre (the
     # pin and crank levers are proportional: l_ring = zp/zc l_c), so F_i = F_max sin(phi_i)/S_i
     # on the loaded half. A slow, well damped run is quasi-static: tolerance 1 % of F_max.

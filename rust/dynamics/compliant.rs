@@ -1,5 +1,5 @@
 //! Compliant-joint model: spring-damper bearings between the cranks, the discs and the carrier
-//! (design.md section 5, "compliant joints add crank and disc translations").
+//! (docs/model.md#compliant-joint-model: compliant joints add crank and disc translations).
 //!
 //! Every coordinate is absolute in the fixed frame, so the mass matrix is constant and
 //! diagonal. The full coordinate vector is
@@ -53,7 +53,7 @@ pub const CARRIER: usize = 0;
 /// Index of the sun angle in the full coordinate vector (unused without a first stage).
 pub const SUN: usize = 1;
 
-/// Typical compliant joints (assumed; orders of magnitude from notes/physics.md section 4:
+/// Typical compliant joints (assumed; orders of magnitude from docs/model.md#compliant-joint-model:
 /// needle bearings ~1e9 N/m radial, crank/main bearings ~1e9-5e9 N/m):
 /// - eccentric (needle) bearing between each eccentric and its disc hole: 1.0e9 N/m,
 ///   1.0e4 N s/m (damping ratio about 0.04 for a disc on its three bearings);

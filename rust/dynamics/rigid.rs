@@ -1,4 +1,4 @@
-//! Rigid-joint model in reduced coordinates (design.md section 5).
+//! Rigid-joint model in reduced coordinates (docs/model.md#coordinates-and-degrees-of-freedom).
 //!
 //! Coordinates `x = [th_c, alpha, th_s]`: carrier angle, absolute crank angle (all cranks equal
 //! when the joints are ideal), sun angle. Disc `k` (eccentric phase `a_k`) has its centre at

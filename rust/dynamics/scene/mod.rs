@@ -1,7 +1,9 @@
 //! A reducer scene: everything a dynamic run needs, serialisable to JSON and TOML.
 //!
 //! Every field is SI. Optional fields (`None`) are computed from the geometry when the model is
-//! built. [`Scene::paper`] is the default scene of design.md section 7.
+//! built. [`Scene::paper`] is the default scene of docs/model.md#default-scene.
+
+pub mod schema;
 
 use crate::contact::ImpactLaw;
 use crate::error::{Result, RvdynError};
@@ -296,7 +298,7 @@ pub const PAPER_POWER: f64 = 112e3;
 pub const PAPER_PRINTED_LOAD: f64 = 4024.9;
 
 impl Scene {
-    /// The default scene of design.md section 7 with the chosen load case: `"idle"`,
+    /// The default scene of docs/model.md#default-scene with the chosen load case: `"idle"`,
     /// `"paper"` (the printed 4024.9 N m) or `"rated"` (43.9 kN m = 57 x 770.6 N m, lossless
     /// 112 kW at 8328 deg/s).
     pub fn paper(load: &str) -> Result<Self> {
