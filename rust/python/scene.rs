@@ -2,8 +2,8 @@
 //! once from JSON, TOML or the paper's preset and changed by dotted paths in Rust. Runs take it
 //! as it is, without parsing or validating again.
 
-use crate::dynamics::compliant::{CompliantModel, default_joints};
-use crate::dynamics::rigid::RigidModel;
+use crate::dynamics::model::compliant::{CompliantModel, default_joints};
+use crate::dynamics::model::rigid::RigidModel;
 use crate::dynamics::scene::{Joints, Scene, get_path};
 use crate::error::RvdynError;
 use crate::solve::MechanicalSystem;

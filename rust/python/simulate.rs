@@ -2,9 +2,9 @@
 //! Python `rvdyn.simulate`, `rvdyn.sweep` and `rvdyn.Result` (python/rvdyn/) wrap these.
 
 use super::scene::CompiledScene;
-use crate::dynamics::record::{CHANNELS, Channel, Dtype, Recording};
+use crate::dynamics::run::driver::{RunControl, SimOptions};
+use crate::dynamics::run::recorder::{CHANNELS, Channel, Dtype, Recording};
 use crate::dynamics::scene::Scene;
-use crate::dynamics::simulate::{RunControl, SimOptions};
 use crate::error::RvdynError;
 use crate::solve::{INTEGRATORS, Method};
 use numpy::{IntoPyArray, PyArrayMethods};

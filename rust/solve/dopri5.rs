@@ -90,6 +90,7 @@ const E: [f64; 7] = [
 /// Step-size controller settings and statistics of the adaptive method.
 #[derive(Debug)]
 pub struct Dopri5 {
+    /// Relative tolerance on velocities.
     pub rtol: f64,
     /// Displacement tolerance [m].
     pub atol: f64,

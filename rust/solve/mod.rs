@@ -8,6 +8,8 @@
 //! All three implement [`Integrator`] and are registered by name in [`INTEGRATORS`];
 //! [`jacobian`] holds the finite-difference Jacobian they share with the stability check.
 
+#![warn(missing_docs)]
+
 pub mod dopri5;
 pub mod generalized_alpha;
 pub mod integrator;

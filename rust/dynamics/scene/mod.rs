@@ -23,8 +23,10 @@ pub struct DiscSpec {
     /// Profile modifications of this disc [m, m, rad]; overrides the scene's `cycloid` values.
     #[serde(default)]
     pub d_rp: Option<f64>,
+    /// Equidistant modification of this disc [m] (`None` = the scene's).
     #[serde(default)]
     pub d_rrp: Option<f64>,
+    /// Rotation modification of this disc [rad] (`None` = the scene's).
     #[serde(default)]
     pub d_delta: Option<f64>,
 }
@@ -104,6 +106,7 @@ pub enum ContactLawSpec {
     Impact {
         /// k [N/m^exponent].
         stiffness: f64,
+        /// Force exponent e.
         exponent: f64,
         /// cmax [N s/m].
         max_damping: f64,
@@ -181,7 +184,9 @@ pub enum StartKind {
 pub enum Drive {
     /// Prescribed input speed [rad/s].
     Speed {
+        /// Input speed [rad/s].
         speed: f64,
+        /// How the speed starts.
         start: StartKind,
         /// Ramp duration [s] (for `start = "ramp"`).
         #[serde(default)]
@@ -189,7 +194,9 @@ pub enum Drive {
     },
     /// Prescribed input torque [N m] (the input becomes a degree of freedom).
     Torque {
+        /// Input torque [N m].
         torque: f64,
+        /// Ramp duration [s] (0 = full torque from t = 0).
         #[serde(default)]
         ramp_time: f64,
     },
@@ -202,11 +209,24 @@ pub enum Load {
     /// No load.
     Idle,
     /// Constant torque [N m] from t = 0.
-    Constant { torque: f64 },
+    Constant {
+        /// Torque [N m].
+        torque: f64,
+    },
     /// `before` [N m] until `time` [s], then `after`.
-    Step { before: f64, after: f64, time: f64 },
+    Step {
+        /// Torque before the step [N m].
+        before: f64,
+        /// Torque after the step [N m].
+        after: f64,
+        /// Time of the step [s].
+        time: f64,
+    },
     /// Piecewise-linear table of (t [s], torque [N m]), held constant outside.
-    Table { points: Vec<[f64; 2]> },
+    Table {
+        /// (t [s], torque [N m]) pairs, times strictly increasing.
+        points: Vec<[f64; 2]>,
+    },
 }
 
 impl Load {
@@ -281,12 +301,18 @@ pub struct Scene {
     pub pin_errors: PinErrors,
     /// Material density for computed inertias [kg/m^3].
     pub density: f64,
+    /// Mass properties (`None` entries computed from the geometry).
     #[serde(default)]
     pub inertias: Inertias,
+    /// Rigid or compliant joints.
     pub joints: Joints,
+    /// Contact laws of the pins and meshes.
     pub contact: ContactLaws,
+    /// The input drive.
     pub drive: Drive,
+    /// The load on the output.
     pub load: Load,
+    /// Initial state.
     pub initial: Initial,
 }
 

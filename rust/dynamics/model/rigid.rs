@@ -12,12 +12,12 @@
 //! `Q = -F grad(delta)`. Prescribed coordinates are taken from the drive; the reaction
 //! `M_ii a_i - Q_i` on them is the input torque.
 
-use crate::contact::ImpactLaw;
-use crate::dynamics::drive::DriveProfile;
 use crate::dynamics::model::Layout;
-use crate::dynamics::pin_contact::{DiscPose, WarmStart, penetration_error, pin_query};
+use crate::dynamics::model::drive::DriveProfile;
+use crate::dynamics::model::laws::ContactLaw;
+use crate::dynamics::model::pin_contact::{DiscPose, WarmStart, penetration_error, pin_query};
+use crate::dynamics::run::sink::ContactSink;
 use crate::dynamics::scene::{Initial, Joints, Load, Scene};
-use crate::dynamics::sink::ContactSink;
 use crate::error::{Result, RvdynError};
 use crate::geometry::CycloidGeometry;
 use crate::geometry::mass::{DiscHoles, MassProperties, disc_mass_properties, solid_cylinder};
@@ -32,86 +32,86 @@ pub const SUN: usize = 2;
 
 /// One disc of the model.
 #[derive(Debug, Clone)]
-pub struct DiscModel {
-    pub geometry: CycloidGeometry,
+pub(crate) struct DiscModel {
+    pub(crate) geometry: CycloidGeometry,
     /// Eccentric phase on the crank [rad].
-    pub phase: f64,
+    pub(crate) phase: f64,
     /// Disc angle offset from the carrier angle, `-phase / zc` [rad].
-    pub angle_offset: f64,
+    pub(crate) angle_offset: f64,
 }
 
 /// One fixed pin.
 #[derive(Debug, Clone, Copy)]
-pub struct PinModel {
-    pub centre: [f64; 2],
-    pub radius: f64,
+pub(crate) struct PinModel {
+    pub(crate) centre: [f64; 2],
+    pub(crate) radius: f64,
     /// Nominal angle of the pin on the pin circle [rad] (the kinematic seed of its contact).
-    pub angle: f64,
+    pub(crate) angle: f64,
 }
 
 /// The sun/planet meshes of the first stage.
 #[derive(Debug, Clone, Copy)]
-pub struct MeshModel {
-    pub sun_base_radius: f64,
-    pub planet_base_radius: f64,
+pub(crate) struct MeshModel {
+    pub(crate) sun_base_radius: f64,
+    pub(crate) planet_base_radius: f64,
     /// Total backlash along the line of action [m].
-    pub backlash: f64,
-    pub law: ImpactLaw,
-    pub count: usize,
+    pub(crate) backlash: f64,
+    pub(crate) law: ContactLaw,
+    pub(crate) count: usize,
 }
 
 /// Mass properties actually used by a model (computed or from the scene).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ModelInertias {
-    pub sun: MassProperties,
-    pub crank: MassProperties,
-    pub disc: MassProperties,
-    pub carrier: MassProperties,
-    pub load_inertia: f64,
+pub(crate) struct ModelInertias {
+    pub(crate) sun: MassProperties,
+    pub(crate) crank: MassProperties,
+    pub(crate) disc: MassProperties,
+    pub(crate) carrier: MassProperties,
+    pub(crate) load_inertia: f64,
 }
 
 /// Generalised forces and power flows from one evaluation.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct Forces {
+pub(crate) struct Forces {
     /// Generalised forces on `[th_c, alpha, th_s]` [N m].
-    pub q: [f64; 3],
+    pub(crate) q: [f64; 3],
     /// Power dissipated by contact damping [W].
-    pub dissipation: f64,
+    pub(crate) dissipation: f64,
     /// Elastic energy stored in the contacts [J] (only when asked for).
-    pub potential: f64,
+    pub(crate) potential: f64,
 }
 
 /// The rigid-joint reducer model.
 #[derive(Debug, Clone)]
 pub struct RigidModel {
-    pub discs: Vec<DiscModel>,
-    pub pins: Vec<PinModel>,
-    pub pin_law: ImpactLaw,
-    pub mesh: Option<MeshModel>,
-    pub cranks: usize,
-    pub crank_radius: f64,
-    pub eccentricity: f64,
-    pub inertias: ModelInertias,
+    pub(crate) discs: Vec<DiscModel>,
+    pub(crate) pins: Vec<PinModel>,
+    pub(crate) pin_law: ContactLaw,
+    pub(crate) mesh: Option<MeshModel>,
+    pub(crate) cranks: usize,
+    pub(crate) crank_radius: f64,
+    pub(crate) eccentricity: f64,
+    pub(crate) inertias: ModelInertias,
     /// Diagonal generalised mass of `[th_c, alpha, th_s]`.
-    pub mass: [f64; 3],
+    pub(crate) mass: [f64; 3],
     /// Free coordinates (indices into the full vector).
-    pub free: Vec<usize>,
+    pub(crate) free: Vec<usize>,
     /// The prescribed coordinate, if the drive is a speed.
-    pub prescribed: Option<usize>,
+    pub(crate) prescribed: Option<usize>,
     /// The coordinate the drive acts on (sun, or crank without a first stage).
-    pub input: usize,
-    pub drive: DriveProfile,
-    pub load: Load,
-    pub ratio: f64,
-    pub initial: Initial,
+    pub(crate) input: usize,
+    pub(crate) drive: DriveProfile,
+    pub(crate) load: Load,
+    pub(crate) ratio: f64,
+    pub(crate) initial: Initial,
     /// Lever length per full coordinate [m per rad], turning angle errors into displacements.
-    pub length_scale: [f64; 3],
+    pub(crate) length_scale: [f64; 3],
     /// Penetration beyond which a run is declared unstable [m].
-    pub max_penetration: f64,
+    pub(crate) max_penetration: f64,
     /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start).
-    pub warm_seeds: Vec<Cell<WarmStart>>,
+    pub(crate) warm_seeds: Vec<Cell<WarmStart>>,
     /// Skip the exact query of a pin that provably cannot touch (see [`SeparationBound`]).
-    pub skip_separated: bool,
+    pub(crate) skip_separated: bool,
     separation: Vec<Cell<SeparationBound>>,
     /// Largest distance of a profile point from its disc centre [m].
     profile_reach: f64,
@@ -170,13 +170,13 @@ impl RigidModel {
                 }
             })
             .collect();
-        let pin_law = scene.contact.pin.law(cyc.face_width)?;
+        let pin_law = ContactLaw::from_spec(&scene.contact.pin, cyc.face_width)?;
         let mesh = match &scene.stage1 {
             Some(s) => Some(MeshModel {
                 sun_base_radius: s.sun_base_radius(),
                 planet_base_radius: s.planet_base_radius(),
                 backlash: s.backlash,
-                law: scene.contact.mesh.law(s.face_width)?,
+                law: ContactLaw::from_spec(&scene.contact.mesh, s.face_width)?,
                 count: s.planets as usize,
             }),
             None => None,
@@ -245,7 +245,7 @@ impl RigidModel {
     }
 
     /// Initial full state `(x, v)` at t = 0: kinematic pose, at rest or at kinematic speed.
-    pub fn initial_state(&self) -> ([f64; 3], [f64; 3]) {
+    pub(crate) fn initial_state(&self) -> ([f64; 3], [f64; 3]) {
         let x = [0.0, 0.0, 0.0];
         let mut v = [0.0; 3];
         if self.initial == Initial::Steady {
@@ -269,7 +269,7 @@ impl RigidModel {
     }
 
     /// Sizes of the bodies and contacts (the shapes of recorded arrays).
-    pub fn layout(&self) -> Layout {
+    pub(crate) fn layout(&self) -> Layout {
         Layout {
             discs: self.discs.len(),
             pins: self.pins.len(),
@@ -279,14 +279,14 @@ impl RigidModel {
     }
 
     /// Number of lobes `zc`.
-    pub fn zc(&self) -> f64 {
+    pub(crate) fn zc(&self) -> f64 {
         f64::from(self.discs[0].geometry.lobes())
     }
 
     /// Overwrite the prescribed coordinate of a full state with the drive at time `t`;
     /// returns its acceleration.
     #[inline]
-    pub fn apply_drive(&self, t: f64, x: &mut [f64; 3], v: &mut [f64; 3]) -> f64 {
+    pub(crate) fn apply_drive(&self, t: f64, x: &mut [f64; 3], v: &mut [f64; 3]) -> f64 {
         match self.prescribed {
             Some(p) => {
                 let (ang, spd, acc) = self.drive.motion(t);
@@ -300,7 +300,7 @@ impl RigidModel {
 
     /// Disc `k` centre [m] and angle [rad] for the full coordinates `x`.
     #[inline]
-    pub fn disc_pose(&self, k: usize, x: &[f64; 3]) -> ([f64; 2], f64) {
+    pub(crate) fn disc_pose(&self, k: usize, x: &[f64; 3]) -> ([f64; 2], f64) {
         let d = &self.discs[k];
         let (s, c) = (x[CRANK] + d.phase).sin_cos();
         (
@@ -313,7 +313,7 @@ impl RigidModel {
     ///
     /// Fails with `SimulationError` if a state is not finite or a penetration exceeds the
     /// physical bound or an exact gap cannot be found (the disc is far from any sensible pose).
-    pub fn forces<S: ContactSink>(
+    pub(crate) fn forces<S: ContactSink>(
         &self,
         t: f64,
         x: &[f64; 3],
@@ -379,16 +379,7 @@ impl RigidModel {
             let delta = m.sun_base_radius * (x[SUN] - x[CARRIER])
                 + m.planet_base_radius * (x[CRANK] - x[CARRIER]);
             let rate = m.sun_base_radius * (v[SUN] - vc) + m.planet_base_radius * (va - vc);
-            let half = 0.5 * m.backlash;
-            let (f, elastic, pen, pen_rate) = if delta > half {
-                let p = delta - half;
-                (m.law.force(p, rate), m.law.elastic_force(p), p, rate)
-            } else if delta < -half {
-                let p = -delta - half;
-                (-m.law.force(p, -rate), -m.law.elastic_force(p), p, -rate)
-            } else {
-                (0.0, 0.0, 0.0, 0.0)
-            };
+            let (f, elastic, pen, pen_rate) = m.law.mesh(m.backlash, delta, rate);
             if pen > 0.0 {
                 if check && (pen.is_nan() || pen >= self.max_penetration) {
                     return Err(penetration_error(
@@ -425,7 +416,7 @@ impl RigidModel {
     }
 
     /// Kinetic energy of the free bodies [J] (the prescribed input is a driver, not counted).
-    pub fn kinetic_energy(&self, v: &[f64; 3]) -> f64 {
+    pub(crate) fn kinetic_energy(&self, v: &[f64; 3]) -> f64 {
         (0..3)
             .filter(|i| Some(*i) != self.prescribed && (*i != SUN || self.mesh.is_some()))
             .map(|i| 0.5 * self.mass[i] * v[i] * v[i])
@@ -487,8 +478,8 @@ fn add(a: MassProperties, b: MassProperties) -> MassProperties {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dynamics::sink::NoSink;
-    use crate::dynamics::system::RigidSystem;
+    use crate::dynamics::model::rigid_system::RigidSystem;
+    use crate::dynamics::run::sink::NoSink;
     use crate::solve::State;
     use crate::solve::generalized_alpha::GeneralizedAlpha;
 

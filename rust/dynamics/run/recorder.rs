@@ -1,7 +1,7 @@
 //! Recording of selected channels at sample times, into flat arrays (first axis = time).
 
 use crate::dynamics::model::{Layout, ReducerModel};
-use crate::dynamics::sink::ContactSink;
+use crate::dynamics::run::sink::ContactSink;
 use crate::error::{Result, RvdynError};
 use crate::solve::Stats;
 use std::collections::BTreeMap;
@@ -313,14 +313,18 @@ pub static CHANNELS: &[ChannelSpec] = &[
 /// One recorded array: flat data and the shape of one sample.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Series {
+    /// Samples one after the other, each row-major.
     pub data: Vec<f64>,
+    /// Shape of one sample.
     pub sample_shape: Vec<usize>,
 }
 
 /// Everything a run recorded, by name (see the Python `Result` for the meaning of each).
 #[derive(Debug, Clone, Default)]
 pub struct Recording {
+    /// Recorded arrays by channel name (see [`CHANNELS`]).
     pub series: BTreeMap<&'static str, Series>,
+    /// Number of samples.
     pub samples: usize,
     /// Integrator statistics: steps, force evaluations, Jacobians, rejected or split steps.
     pub stats: Stats,

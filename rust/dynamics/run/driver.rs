@@ -1,10 +1,10 @@
 //! The simulation driver: integrate a scene to `t_end`, recording at fixed sample times.
 
 use crate::dynamics::model::ReducerModel;
-use crate::dynamics::record::{Channel, Recorder, Recording};
-use crate::dynamics::rigid::RigidModel;
+use crate::dynamics::model::rigid::RigidModel;
+use crate::dynamics::model::rigid_system::RigidSystem;
+use crate::dynamics::run::recorder::{Channel, Recorder, Recording};
 use crate::dynamics::scene::{Joints, Scene};
-use crate::dynamics::system::RigidSystem;
 use crate::error::{Result, RvdynError};
 use crate::solve::{Integrator, Method, Settings, State};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -14,6 +14,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 pub struct SimOptions {
     /// End time [s].
     pub t_end: f64,
+    /// The integrator (a registry entry).
     pub method: Method,
     /// Step [s] of the fixed-step methods; initial step of the adaptive one. `None` = default.
     pub dt: Option<f64>,
@@ -28,6 +29,7 @@ pub struct SimOptions {
     pub record_interval: Option<f64>,
     /// Largest number of samples kept (memory bound: the interval is coarsened to fit).
     pub max_samples: usize,
+    /// Channel groups recorded.
     pub channels: Vec<Channel>,
     /// Skip the exact query of pins that provably cannot touch (exact: same answer).
     pub skip_separated: bool,
@@ -162,7 +164,7 @@ pub fn simulate(scene: &Scene, options: &SimOptions, control: &RunControl) -> Re
             run(&RigidSystem::new(&model), options, control)
         }
         Joints::Compliant { .. } => {
-            let model = crate::dynamics::compliant::CompliantModel::new(scene)?;
+            let model = crate::dynamics::model::compliant::CompliantModel::new(scene)?;
             run(&model, options, control)
         }
     }
