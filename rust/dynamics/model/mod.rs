@@ -9,6 +9,7 @@
 pub mod compliant;
 pub mod drive;
 pub mod laws;
+pub(crate) mod parts;
 pub mod pin_contact;
 pub mod rigid;
 pub mod rigid_system;
@@ -88,8 +89,8 @@ mod tests {
     use crate::dynamics::model::rigid::RigidModel;
     use crate::dynamics::model::rigid_system::RigidSystem;
     use crate::dynamics::scene::Scene;
-    use crate::solve::generalized_alpha::GeneralizedAlpha;
     use crate::solve::State;
+    use crate::solve::generalized_alpha::GeneralizedAlpha;
 
     /// After 2 ms of the rated scene from rest (a loaded state), `eval` is `Q / M`. Not bit for
     /// bit: the second evaluation starts each exact-gap Newton iteration from the first one's

@@ -1,7 +1,7 @@
 //! One pin against one disc in a given pose: the exact penetration, normal and contact point.
 //! Shared by the rigid- and compliant-joint models.
 
-use crate::dynamics::model::rigid::{DiscModel, PinModel};
+use crate::dynamics::model::parts::{DiscModel, PinModel};
 use crate::error::{Result, RvdynError};
 use crate::geometry::gap::small_sin_cos;
 use std::cell::Cell;

@@ -12,15 +12,11 @@
 //! `Q = -F grad(delta)`. Prescribed coordinates are taken from the drive; the reaction
 //! `M_ii a_i - Q_i` on them is the input torque.
 
-use crate::dynamics::model::Layout;
-use crate::dynamics::model::drive::DriveProfile;
-use crate::dynamics::model::laws::ContactLaw;
+pub(crate) use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::pin_contact::{DiscPose, WarmStart, penetration_error, pin_query};
 use crate::dynamics::run::sink::ContactSink;
-use crate::dynamics::scene::{Initial, Joints, Load, Scene};
+use crate::dynamics::scene::{Initial, Joints, Scene};
 use crate::error::{Result, RvdynError};
-use crate::geometry::CycloidGeometry;
-use crate::geometry::mass::{DiscHoles, MassProperties, disc_mass_properties, solid_cylinder};
 use std::cell::Cell;
 
 /// Index of the carrier angle in the full coordinate vector.
@@ -29,46 +25,6 @@ pub const CARRIER: usize = 0;
 pub const CRANK: usize = 1;
 /// Index of the sun angle.
 pub const SUN: usize = 2;
-
-/// One disc of the model.
-#[derive(Debug, Clone)]
-pub(crate) struct DiscModel {
-    pub(crate) geometry: CycloidGeometry,
-    /// Eccentric phase on the crank [rad].
-    pub(crate) phase: f64,
-    /// Disc angle offset from the carrier angle, `-phase / zc` [rad].
-    pub(crate) angle_offset: f64,
-}
-
-/// One fixed pin.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct PinModel {
-    pub(crate) centre: [f64; 2],
-    pub(crate) radius: f64,
-    /// Nominal angle of the pin on the pin circle [rad] (the kinematic seed of its contact).
-    pub(crate) angle: f64,
-}
-
-/// The sun/planet meshes of the first stage.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct MeshModel {
-    pub(crate) sun_base_radius: f64,
-    pub(crate) planet_base_radius: f64,
-    /// Total backlash along the line of action [m].
-    pub(crate) backlash: f64,
-    pub(crate) law: ContactLaw,
-    pub(crate) count: usize,
-}
-
-/// Mass properties actually used by a model (computed or from the scene).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct ModelInertias {
-    pub(crate) sun: MassProperties,
-    pub(crate) crank: MassProperties,
-    pub(crate) disc: MassProperties,
-    pub(crate) carrier: MassProperties,
-    pub(crate) load_inertia: f64,
-}
 
 /// Generalised forces and power flows from one evaluation.
 #[derive(Debug, Clone, Copy, Default)]
@@ -81,17 +37,11 @@ pub(crate) struct Forces {
     pub(crate) potential: f64,
 }
 
-/// The rigid-joint reducer model.
+/// The rigid-joint reducer model: the shared [`Parts`] plus its coordinates.
 #[derive(Debug, Clone)]
 pub struct RigidModel {
-    pub(crate) discs: Vec<DiscModel>,
-    pub(crate) pins: Vec<PinModel>,
-    pub(crate) pin_law: ContactLaw,
-    pub(crate) mesh: Option<MeshModel>,
-    pub(crate) cranks: usize,
-    pub(crate) crank_radius: f64,
-    pub(crate) eccentricity: f64,
-    pub(crate) inertias: ModelInertias,
+    /// Geometry, laws, inertias, drive and load (shared with the compliant model).
+    pub(crate) parts: Parts,
     /// Diagonal generalised mass of `[th_c, alpha, th_s]`.
     pub(crate) mass: [f64; 3],
     /// Free coordinates (indices into the full vector).
@@ -100,21 +50,20 @@ pub struct RigidModel {
     pub(crate) prescribed: Option<usize>,
     /// The coordinate the drive acts on (sun, or crank without a first stage).
     pub(crate) input: usize,
-    pub(crate) drive: DriveProfile,
-    pub(crate) load: Load,
-    pub(crate) ratio: f64,
-    pub(crate) initial: Initial,
     /// Lever length per full coordinate [m per rad], turning angle errors into displacements.
     pub(crate) length_scale: [f64; 3],
-    /// Penetration beyond which a run is declared unstable [m].
-    pub(crate) max_penetration: f64,
     /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start).
     pub(crate) warm_seeds: Vec<Cell<WarmStart>>,
     /// Skip the exact query of a pin that provably cannot touch (see [`SeparationBound`]).
     pub(crate) skip_separated: bool,
     separation: Vec<Cell<SeparationBound>>,
-    /// Largest distance of a profile point from its disc centre [m].
-    profile_reach: f64,
+}
+
+impl std::ops::Deref for RigidModel {
+    type Target = Parts;
+    fn deref(&self) -> &Parts {
+        &self.parts
+    }
 }
 
 /// The last exact gap of one (disc, pin) pair and the disc pose it was computed at. Moving a
@@ -139,53 +88,13 @@ impl RigidModel {
                     .into(),
             ));
         }
+        let parts = Parts::new(scene)?;
         let cyc = scene.cycloid;
         let zp = cyc.pins as usize;
-        let zc = (cyc.pins - 1) as f64;
-        let mut discs = Vec::with_capacity(scene.discs.len());
-        for (k, d) in scene.discs.iter().enumerate() {
-            discs.push(DiscModel {
-                geometry: CycloidGeometry::new(scene.disc_params(k))?,
-                phase: d.phase,
-                angle_offset: -d.phase / zc,
-            });
-        }
-        let pins = (0..zp)
-            .map(|j| {
-                let th = std::f64::consts::TAU * j as f64 / zp as f64;
-                let dp = scene
-                    .pin_errors
-                    .position
-                    .get(j)
-                    .copied()
-                    .unwrap_or([0.0, 0.0]);
-                let dr = scene.pin_errors.radius.get(j).copied().unwrap_or(0.0);
-                PinModel {
-                    centre: [
-                        cyc.pin_circle_radius * th.cos() + dp[0],
-                        cyc.pin_circle_radius * th.sin() + dp[1],
-                    ],
-                    radius: cyc.pin_radius + dr,
-                    angle: th,
-                }
-            })
-            .collect();
-        let pin_law = ContactLaw::from_spec(&scene.contact.pin, cyc.face_width)?;
-        let mesh = match &scene.stage1 {
-            Some(s) => Some(MeshModel {
-                sun_base_radius: s.sun_base_radius(),
-                planet_base_radius: s.planet_base_radius(),
-                backlash: s.backlash,
-                law: ContactLaw::from_spec(&scene.contact.mesh, s.face_width)?,
-                count: s.planets as usize,
-            }),
-            None => None,
-        };
-        let crank_radius = scene.stage1.as_ref().map_or(0.09, |s| s.centre_distance());
-        let inertias = default_inertias(scene, &discs[0].geometry, crank_radius)?;
+        let (inertias, mesh, crank_radius) = (parts.inertias, parts.mesh, parts.crank_radius);
         let n_cr = f64::from(scene.cranks);
         let e = cyc.eccentricity;
-        let nd = discs.len() as f64;
+        let nd = parts.discs.len() as f64;
         let mass = [
             inertias.carrier.inertia
                 + inertias.load_inertia
@@ -195,8 +104,7 @@ impl RigidModel {
             inertias.sun.inertia,
         ];
         let input = if mesh.is_some() { SUN } else { CRANK };
-        let drive = DriveProfile::new(&scene.drive);
-        let (free, prescribed) = match (drive.is_speed(), mesh.is_some()) {
+        let (free, prescribed) = match (parts.drive.is_speed(), mesh.is_some()) {
             (true, true) => (vec![CARRIER, CRANK], Some(SUN)),
             (false, true) => (vec![CARRIER, CRANK, SUN], None),
             (true, false) => (vec![CARRIER], Some(CRANK)),
@@ -205,25 +113,12 @@ impl RigidModel {
         let rp = cyc.pin_circle_radius;
         let length_scale = [rp, e, mesh.map_or(0.0, |m| m.sun_base_radius)];
         Ok(Self {
-            discs,
-            pins,
-            pin_law,
-            mesh,
-            cranks: scene.cranks as usize,
-            crank_radius,
-            eccentricity: e,
-            inertias,
+            parts,
             mass,
             free,
             prescribed,
             input,
-            drive,
-            load: scene.load.clone(),
-            ratio: scene.ratio(),
-            initial: scene.initial,
             length_scale,
-            // A tenth of the pin radius is far beyond any elastic approach of steel.
-            max_penetration: 0.1 * cyc.pin_radius,
             warm_seeds: vec![Cell::new(WarmStart::default()); scene.discs.len() * zp],
             skip_separated: true,
             separation: vec![
@@ -234,13 +129,6 @@ impl RigidModel {
                 });
                 scene.discs.len() * zp
             ],
-            profile_reach: (0..scene.discs.len())
-                .map(|k| {
-                    let p = scene.disc_params(k);
-                    p.pin_circle_radius + p.d_rp + p.eccentricity - p.pin_radius - p.d_rrp
-                })
-                .fold(0.0, f64::max)
-                * 1.000_001,
         })
     }
 
@@ -266,21 +154,6 @@ impl RigidModel {
             return (x, v);
         }
         (x, v)
-    }
-
-    /// Sizes of the bodies and contacts (the shapes of recorded arrays).
-    pub(crate) fn layout(&self) -> Layout {
-        Layout {
-            discs: self.discs.len(),
-            pins: self.pins.len(),
-            cranks: self.cranks,
-            meshes: self.mesh.map_or(0, |m| m.count),
-        }
-    }
-
-    /// Number of lobes `zc`.
-    pub(crate) fn zc(&self) -> f64 {
-        f64::from(self.discs[0].geometry.lobes())
     }
 
     /// Overwrite the prescribed coordinate of a full state with the drive at time `t`;
@@ -421,57 +294,6 @@ impl RigidModel {
             .filter(|i| Some(*i) != self.prescribed && (*i != SUN || self.mesh.is_some()))
             .map(|i| 0.5 * self.mass[i] * v[i] * v[i])
             .sum()
-    }
-}
-
-/// Mass properties from the scene or from simple steel solids (stated in each line).
-fn default_inertias(
-    scene: &Scene,
-    disc: &CycloidGeometry,
-    crank_radius: f64,
-) -> Result<ModelInertias> {
-    let rho = scene.density;
-    let i = &scene.inertias;
-    let (sun_r, planet_r, gear_w) = scene.stage1.as_ref().map_or((0.027, 0.063, 0.03), |s| {
-        (s.sun_pitch_radius(), s.planet_pitch_radius(), s.face_width)
-    });
-    // Sun: gear cylinder at its pitch radius, plus a 20 mm radius, 150 mm input shaft.
-    let sun = i.sun.unwrap_or_else(|| {
-        add(
-            solid_cylinder(sun_r, gear_w, rho),
-            solid_cylinder(0.020, 0.150, rho),
-        )
-    });
-    // Crank: planet gear cylinder at its pitch radius, plus a 25 mm radius, 150 mm crankshaft.
-    let crank = i.crank.unwrap_or_else(|| {
-        add(
-            solid_cylinder(planet_r, gear_w, rho),
-            solid_cylinder(0.025, 0.150, rho),
-        )
-    });
-    let disc_mp = match i.disc {
-        Some(d) => d,
-        None => disc_mass_properties(disc, &DiscHoles::paper(), rho)?,
-    };
-    // Carrier: two end plates of radius rp - rrp - 10 mm, 30 mm thick.
-    let plate_r = scene.cycloid.pin_circle_radius - scene.cycloid.pin_radius - 0.010;
-    let carrier = i.carrier.unwrap_or_else(|| {
-        let p = solid_cylinder(plate_r.max(crank_radius), 0.030, rho);
-        add(p, p)
-    });
-    Ok(ModelInertias {
-        sun,
-        crank,
-        disc: disc_mp,
-        carrier,
-        load_inertia: i.load_inertia,
-    })
-}
-
-fn add(a: MassProperties, b: MassProperties) -> MassProperties {
-    MassProperties {
-        mass: a.mass + b.mass,
-        inertia: a.inertia + b.inertia,
     }
 }
 

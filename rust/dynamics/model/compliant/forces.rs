@@ -21,7 +21,7 @@ impl CompliantModel {
         qf: &mut [f64],
         sink: &mut S,
     ) -> Result<Flows> {
-        let m = &self.base;
+        let m = &self.parts;
         let nd = m.discs.len();
         let want_energy = sink.wants_energy();
         let mut out = Flows::default();

@@ -42,8 +42,8 @@ use std::f64::consts::TAU;
 
 use crate::dynamics::model::laws::BearingLaw;
 pub use crate::dynamics::model::laws::{BearingLoad, linear_bearing as bearing_load};
+use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::pin_contact::WarmStart;
-use crate::dynamics::model::rigid::RigidModel;
 use crate::dynamics::model::vec2::{add, perp, rotate, scaled, sub};
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
 use crate::dynamics::run::sink::{ContactSink, DynSink, NoSink};
@@ -89,8 +89,8 @@ pub(crate) struct Flows {
 /// The compliant-joint reducer model (a [`MechanicalSystem`] in its free coordinates).
 #[derive(Debug, Clone)]
 pub struct CompliantModel {
-    /// The rigid model of the same scene: geometry, laws, inertias, drive and load.
-    pub base: RigidModel,
+    /// Geometry, laws, inertias, drive and load (shared with the rigid model).
+    pub(crate) parts: Parts,
     /// Law of the needle bearing between each eccentric and its disc hole.
     pub eccentric_bearing: BearingLaw,
     /// `None`: rigid crank bearings, the crank centres stay in their seats on the carrier
@@ -134,9 +134,7 @@ impl CompliantModel {
                     .into(),
             ));
         };
-        let mut rigid_scene = scene.clone();
-        rigid_scene.joints = Joints::Rigid;
-        let base = RigidModel::new(&rigid_scene)?;
+        let base = Parts::new(scene)?;
         let n = base.cranks;
         let nd = base.discs.len();
         let seats: Vec<[f64; 2]> = (0..n)
@@ -201,7 +199,7 @@ impl CompliantModel {
             .collect();
         let scale = free.iter().map(|&i| lever[i]).collect();
         Ok(Self {
-            base,
+            parts: base,
             eccentric_bearing: BearingLaw::Linear(eccentric_bearing),
             crank_bearing: crank_bearing.map(BearingLaw::Linear),
             cranks: n,
@@ -231,7 +229,7 @@ impl CompliantModel {
     /// Full kinematic state `(x, v)` at t = 0: kinematic pose, bearings undeflected, at rest
     /// or at kinematic speed (`Initial::Steady`); prescribed coordinates from the drive.
     pub fn full_initial_state(&self) -> (Vec<f64>, Vec<f64>) {
-        let m = &self.base;
+        let m = &self.parts;
         let n_full = self.full_len();
         let mut x = vec![0.0; n_full];
         let mut v = vec![0.0; n_full];
@@ -270,7 +268,7 @@ impl CompliantModel {
         }
         for (i, seat) in self.seats.iter().enumerate() {
             let ci = crank_index(i);
-            let s = scaled(self.base.crank_radius, rotate(x[CARRIER], *seat));
+            let s = scaled(self.parts.crank_radius, rotate(x[CARRIER], *seat));
             let sv = scaled(v[CARRIER], perp(s));
             x[ci..ci + 2].copy_from_slice(&s);
             v[ci..ci + 2].copy_from_slice(&sv);
@@ -284,7 +282,7 @@ impl CompliantModel {
         if self.prescribed.is_empty() {
             return 0.0;
         }
-        let (ang, spd, acc) = self.base.drive.motion(t);
+        let (ang, spd, acc) = self.parts.drive.motion(t);
         for &p in &self.prescribed {
             x[p] = ang;
             v[p] = spd;
@@ -309,7 +307,7 @@ impl CompliantModel {
     /// Deflection `d = p_i - s_i` of crank bearing `i` and `d = H_ik - E_ik` of eccentric
     /// bearing `(i, k)` (at `i * discs + k`) for the full coordinates `x` [m].
     pub fn bearing_deflections(&self, x: &[f64]) -> (Vec<[f64; 2]>, Vec<[f64; 2]>) {
-        let m = &self.base;
+        let m = &self.parts;
         let nd = m.discs.len();
         let mut crank = Vec::with_capacity(self.cranks);
         let mut ecc = Vec::with_capacity(self.cranks * nd);
@@ -365,7 +363,7 @@ impl MechanicalSystem for CompliantModel {
         for (k, &i) in self.free.iter().enumerate() {
             a[k] = qf[i] / self.mass[i];
         }
-        let m = &self.base;
+        let m = &self.parts;
         power[0] = match m.drive.torque(t) {
             Some(tq) => {
                 let share = tq / self.input.len() as f64;
@@ -399,7 +397,7 @@ impl ReducerModel for CompliantModel {
     }
 
     fn layout(&self) -> Layout {
-        self.base.layout()
+        self.parts.layout()
     }
 
     fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
@@ -417,7 +415,7 @@ impl ReducerModel for CompliantModel {
         v: &[f64],
         sink: &mut dyn ContactSink,
     ) -> Result<Observation> {
-        let m = &self.base;
+        let m = &self.parts;
         let (x, xv, acc) = self.full(t, q, v);
         let mut qf = vec![0.0; x.len()];
         let flows = self.forces(t, &x, &xv, &mut qf, &mut DynSink(sink))?;

@@ -128,9 +128,9 @@ fn generalised_forces_are_minus_the_energy_gradient() {
             // Levers: carrier and disc angles 0.1 m, sun r_bs, crank angles e, else 1.
             let l = match i {
                 CARRIER => 0.1,
-                SUN => m.base.mesh.map_or(1.0, |mm| mm.sun_base_radius),
+                SUN => m.parts.mesh.map_or(1.0, |mm| mm.sun_base_radius),
                 _ if (i - 2) % 3 != 2 => 1.0,
-                _ if i < m.disc_index(0) => m.base.eccentricity,
+                _ if i < m.disc_index(0) => m.parts.eccentricity,
                 _ => 0.1,
             };
             let h = 1e-9 / l;
