@@ -13,7 +13,9 @@
 //! `M_ii a_i - Q_i` on them is the input torque.
 
 pub(crate) use crate::dynamics::model::parts::Parts;
-use crate::dynamics::model::pin_contact::{DiscPose, WarmStart, penetration_error, pin_query};
+use crate::dynamics::model::pin_contact::{
+    DiscPose, SeparationBound, WarmStart, penetration_error, pin_query,
+};
 use crate::dynamics::run::sink::ContactSink;
 use crate::dynamics::scene::{Initial, Joints, Scene};
 use crate::error::{Result, RvdynError};
@@ -66,17 +68,6 @@ impl std::ops::Deref for RigidModel {
     }
 }
 
-/// The last exact gap of one (disc, pin) pair and the disc pose it was computed at. Moving a
-/// disc by `dO` and turning it by `dth` moves every profile point by at most
-/// `|dO| + reach |dth|`, and the gap by no more: while `gap - that > 0` the pin cannot touch and
-/// its exact query is skipped. The answer is the same as without skipping (tested).
-#[derive(Debug, Clone, Copy)]
-struct SeparationBound {
-    centre: [f64; 2],
-    angle: f64,
-    gap: f64,
-}
-
 impl RigidModel {
     /// Build the model of a validated scene.
     pub fn new(scene: &Scene) -> Result<Self> {
@@ -121,14 +112,7 @@ impl RigidModel {
             length_scale,
             warm_seeds: vec![Cell::new(WarmStart::default()); scene.discs.len() * zp],
             skip_separated: true,
-            separation: vec![
-                Cell::new(SeparationBound {
-                    centre: [0.0; 2],
-                    angle: 0.0,
-                    gap: f64::NEG_INFINITY
-                });
-                scene.discs.len() * zp
-            ],
+            separation: vec![Cell::new(SeparationBound::default()); scene.discs.len() * zp],
         })
     }
 
@@ -203,15 +187,13 @@ impl RigidModel {
             let pose = DiscPose::new(o, th);
             for (j, pin) in self.pins.iter().enumerate() {
                 let idx = k * self.pins.len() + j;
-                if self.skip_separated {
-                    let b = self.separation[idx].get();
-                    let (dx, dy) = (o[0] - b.centre[0], o[1] - b.centre[1]);
-                    let moved =
-                        (dx * dx + dy * dy).sqrt() + self.profile_reach * (th - b.angle).abs();
-                    if b.gap > moved {
-                        sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
-                        continue;
-                    }
+                if self.skip_separated
+                    && self.separation[idx]
+                        .get()
+                        .separated(o, th, self.profile_reach)
+                {
+                    sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
+                    continue;
                 }
                 let pc = pin_query(d, pin, &pose, t, (k, j), &self.warm_seeds[idx])?;
                 if self.skip_separated {

@@ -164,7 +164,8 @@ pub fn simulate(scene: &Scene, options: &SimOptions, control: &RunControl) -> Re
             run(&RigidSystem::new(&model), options, control)
         }
         Joints::Compliant { .. } => {
-            let model = crate::dynamics::model::compliant::CompliantModel::new(scene)?;
+            let mut model = crate::dynamics::model::compliant::CompliantModel::new(scene)?;
+            model.skip_separated = options.skip_separated;
             run(&model, options, control)
         }
     }

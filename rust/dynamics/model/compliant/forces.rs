@@ -2,7 +2,9 @@
 //! load and drive (docs/model.md#compliant-joint-model).
 
 use super::{CARRIER, CompliantModel, Flows, SUN, crank_index};
-use crate::dynamics::model::pin_contact::{DiscPose, penetration_error, pin_contact};
+use crate::dynamics::model::pin_contact::{
+    DiscPose, SeparationBound, penetration_error, pin_query,
+};
 use crate::dynamics::model::vec2::{add, cross, dot, perp, rotate, scaled, sub};
 use crate::dynamics::run::sink::ContactSink;
 use crate::error::{Result, RvdynError};
@@ -111,11 +113,25 @@ impl CompliantModel {
             let (th, vt) = (x[dk + 2], v[dk + 2]);
             let pose = DiscPose::new(o, th);
             for (j, pin) in m.pins.iter().enumerate() {
-                let warm = &self.warm_seeds[k * m.pins.len() + j];
-                let Some(pc) = pin_contact(disc, pin, &pose, t, (k, j), warm)? else {
+                let idx = k * m.pins.len() + j;
+                if self.skip_separated
+                    && self.separation[idx].get().separated(o, th, m.profile_reach)
+                {
                     sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
                     continue;
-                };
+                }
+                let pc = pin_query(disc, pin, &pose, t, (k, j), &self.warm_seeds[idx])?;
+                if self.skip_separated {
+                    self.separation[idx].set(SeparationBound {
+                        centre: o,
+                        angle: th,
+                        gap: -pc.penetration,
+                    });
+                }
+                if pc.penetration <= 0.0 {
+                    sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
+                    continue;
+                }
                 let pen = pc.penetration;
                 if sink.checks_bounds() && (pen.is_nan() || pen >= m.max_penetration) {
                     let what = format!("pin {} on disc {k}", j + 1);

@@ -26,7 +26,7 @@
 //!   `k (|d| - c) + c_b d|d|/dt`, clamped at 0 (it cannot pull), along `d / |d|`; with `c = 0`
 //!   it is the linear vector spring-damper `F = -k d - c_b d'`;
 //! - pin contacts: the exact contact of each pin with disc `k` in its free pose
-//!   (`pin_contact`); penetration rate `N . (O_k' + theta_k' z x arm)`; force `-F N` on the disc;
+//!   (`pin_query`; pins that provably cannot touch are skipped, as in the rigid model); penetration rate `N . (O_k' + theta_k' z x arm)`; force `-F N` on the disc;
 //! - sun/planet mesh `i`: deflection along the line of action
 //!   `delta_i = r_bs (th_s - th_c) + r_bp (alpha_i - th_c) - (p_i - s_i) . w_i`, with
 //!   `w_i = R(pi/2 - pressure_angle) u_i` the direction in which the sun pushes planet `i`
@@ -43,7 +43,7 @@ use std::f64::consts::TAU;
 use crate::dynamics::model::laws::BearingLaw;
 pub use crate::dynamics::model::laws::{BearingLoad, linear_bearing as bearing_load};
 use crate::dynamics::model::parts::Parts;
-use crate::dynamics::model::pin_contact::WarmStart;
+use crate::dynamics::model::pin_contact::{SeparationBound, WarmStart};
 use crate::dynamics::model::vec2::{add, perp, rotate, scaled, sub};
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
 use crate::dynamics::run::sink::{ContactSink, DynSink, NoSink};
@@ -117,6 +117,9 @@ pub struct CompliantModel {
     /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start;
     /// the contact found does not depend on it).
     warm_seeds: Vec<Cell<WarmStart>>,
+    /// Skip the exact query of a pin that provably cannot touch ([`SeparationBound`]).
+    pub(crate) skip_separated: bool,
+    separation: Vec<Cell<SeparationBound>>,
 }
 
 impl CompliantModel {
@@ -212,6 +215,8 @@ impl CompliantModel {
             input,
             scale,
             warm_seeds: vec![Cell::new(WarmStart::default()); nd * zp],
+            skip_separated: true,
+            separation: vec![Cell::new(SeparationBound::default()); nd * zp],
         })
     }
 
