@@ -204,7 +204,10 @@ def test_sweep_runs_a_grid_and_reports_failures() -> None:
 
 
 def test_ctrl_c_stops_a_run_cleanly() -> None:
-    code = "import rvdyn; rvdyn.simulate(rvdyn.Scene.paper('rated'), 600.0, channels=['motion'], max_samples=1000)"
+    # The child restores the default SIGINT handler: a parent started from a background job
+    # ignores SIGINT and the child would inherit that (the test checks rvdyn, not the shell).
+    code = ("import signal; signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+            "import rvdyn; rvdyn.simulate(rvdyn.Scene.paper('rated'), 600.0, channels=['motion'], max_samples=1000)")
     proc = subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE, text=True)
     time.sleep(3.0)
     proc.send_signal(signal.SIGINT)
