@@ -3,14 +3,20 @@
 //! Every field is SI. Optional fields (`None`) are computed from the geometry when the model is
 //! built. [`Scene::paper`] is the default scene of docs/model.md#default-scene.
 
+mod paths;
+mod presets;
 pub mod schema;
+mod validate;
+
+pub use paths::get_path;
+pub(crate) use paths::{set_path, unknown_fields};
+pub use presets::{PAPER_INPUT_SPEED, PAPER_POWER, PAPER_PRINTED_LOAD};
 
 use crate::contact::ImpactLaw;
 use crate::error::{Result, RvdynError};
 use crate::geometry::cycloid::CycloidParams;
 use crate::geometry::involute::InvoluteStage;
 use crate::geometry::mass::MassProperties;
-use crate::kinematics::operating_point;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -316,73 +322,7 @@ pub struct Scene {
     pub initial: Initial,
 }
 
-/// The paper's input speed, 8328 deg/s [rad/s].
-pub const PAPER_INPUT_SPEED: f64 = 8328.0 * PI / 180.0;
-/// The paper's power, 112 kW [W].
-pub const PAPER_POWER: f64 = 112e3;
-/// The paper's printed output torque [N m] (inconsistent with 112 kW: erratum 3).
-pub const PAPER_PRINTED_LOAD: f64 = 4024.9;
-
 impl Scene {
-    /// The default scene of docs/model.md#default-scene with the chosen load case: `"idle"`,
-    /// `"paper"` (the printed 4024.9 N m) or `"rated"` (43.9 kN m = 57 x 770.6 N m, lossless
-    /// 112 kW at 8328 deg/s).
-    pub fn paper(load: &str) -> Result<Self> {
-        let load = match load {
-            "idle" => Load::Idle,
-            "paper" => Load::Constant {
-                torque: PAPER_PRINTED_LOAD,
-            },
-            "rated" => {
-                let op = operating_point(PAPER_POWER, PAPER_INPUT_SPEED, 57.0)?;
-                Load::Constant {
-                    torque: op.output_torque,
-                }
-            }
-            other => {
-                return Err(RvdynError::Scene(format!(
-                    "unknown load case {other:?}: choose \"idle\", \"paper\" (4024.9 N m as \
-                     printed) or \"rated\" (43.9 kN m, consistent with 112 kW)"
-                )));
-            }
-        };
-        Ok(Scene {
-            name: "paper".into(),
-            stage1: Some(paper_stage1()?),
-            cycloid: CycloidParams::paper(),
-            discs: vec![
-                DiscSpec {
-                    phase: 0.0,
-                    d_rp: None,
-                    d_rrp: None,
-                    d_delta: None,
-                },
-                DiscSpec {
-                    phase: PI,
-                    d_rp: None,
-                    d_rrp: None,
-                    d_delta: None,
-                },
-            ],
-            cranks: 3,
-            pin_errors: PinErrors::default(),
-            density: crate::geometry::mass::STEEL_DENSITY,
-            inertias: Inertias::default(),
-            joints: Joints::Rigid,
-            contact: ContactLaws {
-                pin: ContactLawSpec::paper(),
-                mesh: ContactLawSpec::paper(),
-            },
-            drive: Drive::Speed {
-                speed: PAPER_INPUT_SPEED,
-                start: StartKind::Step,
-                ramp_time: 0.0,
-            },
-            load,
-            initial: Initial::Rest,
-        })
-    }
-
     /// Parse a scene from JSON text.
     pub fn from_json(text: &str) -> Result<Self> {
         let v: serde_json::Value = serde_json::from_str(text)
@@ -438,178 +378,6 @@ impl Scene {
         Self::from_value(&tree)
     }
 
-    /// Check the scene as a whole; errors say which field is wrong and how to fix it.
-    pub fn validate(&self) -> Result<()> {
-        let err = |m: String| Err(RvdynError::Scene(m));
-        if self.discs.is_empty() || self.discs.len() > 2 {
-            return err(format!(
-                "a scene needs 1 or 2 discs, got {}",
-                self.discs.len()
-            ));
-        }
-        for (k, d) in self.discs.iter().enumerate() {
-            for (n, v) in [
-                ("phase", Some(d.phase)),
-                ("d_rp", d.d_rp),
-                ("d_rrp", d.d_rrp),
-                ("d_delta", d.d_delta),
-            ] {
-                if let Some(v) = v
-                    && !v.is_finite()
-                {
-                    return err(format!("discs[{k}].{n} must be finite, got {v}"));
-                }
-            }
-            crate::geometry::CycloidGeometry::check(self.disc_params(k))?;
-        }
-        if self.cranks < 1 {
-            return err("cranks must be at least 1".into());
-        }
-        if let Some(s) = &self.stage1 {
-            s.validate()?;
-            if s.planets != self.cranks {
-                return err(format!(
-                    "stage1.planets = {} must equal cranks = {} (each planet sits on a crank)",
-                    s.planets, self.cranks
-                ));
-            }
-        }
-        let zp = self.cycloid.pins as usize;
-        if !self.pin_errors.position.is_empty() && self.pin_errors.position.len() != zp {
-            return err(format!(
-                "pin_errors.position must have one (dx, dy) per pin ({zp}), got {}",
-                self.pin_errors.position.len()
-            ));
-        }
-        if !self.pin_errors.radius.is_empty() && self.pin_errors.radius.len() != zp {
-            return err(format!(
-                "pin_errors.radius must have one value per pin ({zp}), got {}",
-                self.pin_errors.radius.len()
-            ));
-        }
-        if self
-            .pin_errors
-            .position
-            .iter()
-            .flatten()
-            .chain(&self.pin_errors.radius)
-            .any(|v| !v.is_finite())
-        {
-            return err("pin_errors must be finite".into());
-        }
-        if !(self.density.is_finite() && self.density > 0.0) {
-            return err(format!("density must be > 0 kg/m^3, got {}", self.density));
-        }
-        let i = &self.inertias;
-        for (n, mp) in [
-            ("sun", i.sun),
-            ("crank", i.crank),
-            ("disc", i.disc),
-            ("carrier", i.carrier),
-        ] {
-            if let Some(mp) = mp
-                && !(mp.mass.is_finite()
-                    && mp.mass > 0.0
-                    && mp.inertia.is_finite()
-                    && mp.inertia > 0.0)
-            {
-                return err(format!(
-                    "inertias.{n} needs mass > 0 kg and inertia > 0 kg m^2, got {mp:?}"
-                ));
-            }
-        }
-        if !(i.load_inertia.is_finite() && i.load_inertia >= 0.0) {
-            return err(format!(
-                "inertias.load_inertia must be >= 0 kg m^2, got {}",
-                i.load_inertia
-            ));
-        }
-        if let Joints::Compliant {
-            eccentric_bearing,
-            crank_bearing,
-        } = self.joints
-        {
-            for (n, b) in [
-                ("eccentric_bearing", Some(eccentric_bearing)),
-                ("crank_bearing", crank_bearing),
-            ]
-            .into_iter()
-            .filter_map(|(n, b)| b.map(|b| (n, b)))
-            {
-                if !(b.stiffness.is_finite()
-                    && b.stiffness > 0.0
-                    && b.damping.is_finite()
-                    && b.damping >= 0.0
-                    && b.clearance.is_finite()
-                    && b.clearance >= 0.0)
-                {
-                    return err(format!(
-                        "joints.{n} needs stiffness > 0 N/m, damping >= 0 N s/m, clearance >= 0 m; got {b:?}"
-                    ));
-                }
-            }
-        }
-        self.contact.pin.law(self.cycloid.face_width)?;
-        if let Some(s) = &self.stage1 {
-            self.contact.mesh.law(s.face_width)?;
-        }
-        match self.drive {
-            Drive::Speed {
-                speed,
-                start,
-                ramp_time,
-            } => {
-                if !speed.is_finite() {
-                    return err(format!("drive.speed must be finite rad/s, got {speed}"));
-                }
-                if start == StartKind::Ramp && !(ramp_time.is_finite() && ramp_time > 0.0) {
-                    return err(format!(
-                        "drive.ramp_time must be > 0 s for a ramp start, got {ramp_time}"
-                    ));
-                }
-            }
-            Drive::Torque { torque, ramp_time } => {
-                if !(torque.is_finite() && ramp_time.is_finite() && ramp_time >= 0.0) {
-                    return err(format!(
-                        "drive.torque must be finite and ramp_time >= 0, got {torque}, {ramp_time}"
-                    ));
-                }
-                if self.initial == Initial::Steady {
-                    return err("initial = \"steady\" needs a speed drive (the steady speed is undefined for a torque drive)".into());
-                }
-            }
-        }
-        match &self.load {
-            Load::Idle => {}
-            Load::Constant { torque } => {
-                if !torque.is_finite() {
-                    return err(format!("load.torque must be finite N m, got {torque}"));
-                }
-            }
-            Load::Step {
-                before,
-                after,
-                time,
-            } => {
-                if !(before.is_finite() && after.is_finite() && time.is_finite()) {
-                    return err("load step values must be finite".into());
-                }
-            }
-            Load::Table { points } => {
-                if points.is_empty() {
-                    return err("load.points needs at least one (t, torque) pair".into());
-                }
-                if points.iter().flatten().any(|v| !v.is_finite()) {
-                    return err("load.points must be finite".into());
-                }
-                if points.windows(2).any(|w| w[1][0] <= w[0][0]) {
-                    return err("load.points times must increase strictly".into());
-                }
-            }
-        }
-        Ok(())
-    }
-
     /// Geometry parameters of disc `k` (scene values with the disc's own modifications).
     pub fn disc_params(&self, k: usize) -> CycloidParams {
         let mut p = self.cycloid;
@@ -630,100 +398,6 @@ impl Scene {
             None => -(zp - 1.0),
         }
     }
-}
-
-/// The value at dotted `path` of a scene tree.
-pub fn get_path<'a>(tree: &'a serde_json::Value, path: &str) -> Result<&'a serde_json::Value> {
-    let mut node = tree;
-    for key in path_keys(path)? {
-        node = match node {
-            serde_json::Value::Object(m) => m.get(key),
-            serde_json::Value::Array(a) => key.parse::<usize>().ok().and_then(|i| a.get(i)),
-            _ => None,
-        }
-        .ok_or_else(|| RvdynError::Scene(format!("scene has no field {path:?} (at {key:?})")))?;
-    }
-    Ok(node)
-}
-
-fn path_keys(path: &str) -> Result<Vec<&str>> {
-    if path.is_empty() || path.split('.').any(str::is_empty) {
-        return Err(RvdynError::Scene(format!(
-            "a scene field path must be a non-empty dotted path like \"load.torque\", got {path:?}"
-        )));
-    }
-    Ok(path.split('.').collect())
-}
-
-/// Set the value at dotted `path` (the parent must exist; the last key must be a field of an
-/// object, or an index inside a list).
-fn set_path(tree: &mut serde_json::Value, path: &str, value: serde_json::Value) -> Result<()> {
-    let keys = path_keys(path)?;
-    let (last, parents) = keys.split_last().expect("non-empty path");
-    let missing = || RvdynError::Scene(format!("scene has no field {path:?}"));
-    let mut node = tree;
-    for key in parents {
-        node = match node {
-            serde_json::Value::Object(m) => m.get_mut(*key),
-            serde_json::Value::Array(a) => key.parse::<usize>().ok().and_then(|i| a.get_mut(i)),
-            _ => None,
-        }
-        .ok_or_else(|| RvdynError::Scene(format!("scene has no field {path:?} (at {key:?})")))?;
-    }
-    match node {
-        serde_json::Value::Object(m) => {
-            m.insert((*last).to_string(), value);
-        }
-        serde_json::Value::Array(a) => {
-            let slot = last
-                .parse::<usize>()
-                .ok()
-                .and_then(|i| a.get_mut(i))
-                .ok_or_else(missing)?;
-            *slot = value;
-        }
-        _ => return Err(missing()),
-    }
-    Ok(())
-}
-
-/// First key of `given` that the schema dropped when `normal` was written back.
-fn unknown_fields(given: &serde_json::Value, normal: &serde_json::Value, at: &str) -> Result<()> {
-    use serde_json::Value;
-    match (given, normal) {
-        (Value::Object(g), Value::Object(n)) => {
-            for (k, gv) in g {
-                let path = if at.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{at}.{k}")
-                };
-                match n.get(k) {
-                    Some(nv) => unknown_fields(gv, nv, &path)?,
-                    None => {
-                        let known: Vec<&str> = n.keys().map(String::as_str).collect();
-                        return Err(RvdynError::Scene(format!(
-                            "unknown scene field {path:?}; the fields here are {}",
-                            known.join(", ")
-                        )));
-                    }
-                }
-            }
-            Ok(())
-        }
-        (Value::Array(g), Value::Array(n)) => {
-            for (i, (gv, nv)) in g.iter().zip(n).enumerate() {
-                unknown_fields(gv, nv, &format!("{at}.{i}"))?;
-            }
-            Ok(())
-        }
-        _ => Ok(()),
-    }
-}
-
-/// The paper's first stage: 18/42 teeth, 3 planets, module 3 mm, 20 deg, face 30 mm.
-fn paper_stage1() -> Result<InvoluteStage> {
-    InvoluteStage::new(18, 42, 3, 3e-3, 20f64.to_radians(), 0.030)
 }
 
 #[cfg(test)]
