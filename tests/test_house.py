@@ -208,3 +208,19 @@ def test_dopri5_stops_with_advice_on_a_stiff_scene() -> None:
     assert "Hz" in str(info.value)
     # The implicit method runs the same scene.
     assert simulate(s, 5e-3, channels=["motion"]).ok
+
+
+def test_work_and_memory_are_bounded() -> None:
+    # Issue 12 D3/D4/D14 (the simulate part): a sample count that overflowed returned an empty
+    # Result, dt = 1e-300 ran forever, a huge max_samples could abort on allocation.
+    s = Scene.paper("rated")
+    with pytest.raises(rvdyn.ParameterError, match="steps"):
+        simulate(s, 0.01, dt=1e-300)
+    for n in (2**64 - 1, 10**12):
+        with pytest.raises(rvdyn.ParameterError, match="max_samples"):
+            simulate(s, 0.01, max_samples=n, record_interval=5e-324)
+    with pytest.raises(rvdyn.ParameterError, match="steps"):
+        sweep([s], 0.01, "rk4", dt=1e-300)
+    # The largest accepted count still runs (the interval is what bounds the samples here).
+    r = simulate(s, 1e-3, max_samples=10**8, record_interval=1e-4, channels="motion")
+    assert r.t.shape == (11,)
