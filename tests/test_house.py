@@ -224,3 +224,24 @@ def test_work_and_memory_are_bounded() -> None:
     # The largest accepted count still runs (the interval is what bounds the samples here).
     r = simulate(s, 1e-3, max_samples=10**8, record_interval=1e-4, channels="motion")
     assert r.t.shape == (11,)
+
+
+def test_damaged_result_files_raise_parameter_error(tmp_path: Path) -> None:
+    # Issue 12 D9 (the Result.load part): KeyError, JSONDecodeError, BadZipFile, EOFError...
+    good = simulate(Scene.paper("rated"), 1e-3, channels="motion").save(tmp_path / "good.npz")
+    cases = {
+        "missing.npz": None,
+        "text.npz": b"not a zip file",
+        "empty.npz": b"",
+        "truncated.npz": good.read_bytes()[:200],
+    }
+    for name, data in cases.items():
+        if data is not None:
+            (tmp_path / name).write_bytes(data)
+    np.savez(tmp_path / "nometa.npz", t=np.zeros(3))
+    np.savez(tmp_path / "badmeta.npz", __meta__=np.array("{not json"), t=np.zeros(3))
+    np.savez(tmp_path / "listmeta.npz", __meta__=np.array("[1, 2]"), t=np.zeros(3))
+    for name in [*cases, "nometa.npz", "badmeta.npz", "listmeta.npz"]:
+        with pytest.raises(rvdyn.ParameterError, match="cannot read result file"):
+            Result.load(tmp_path / name)
+    assert Result.load(good).t.shape == (11,)
