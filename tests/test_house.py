@@ -245,3 +245,25 @@ def test_damaged_result_files_raise_parameter_error(tmp_path: Path) -> None:
         with pytest.raises(rvdyn.ParameterError, match="cannot read result file"):
             Result.load(tmp_path / name)
     assert Result.load(good).t.shape == (11,)
+
+
+def test_numpy_integers_are_accepted_as_counts() -> None:
+    s = Scene.paper("rated")
+    o = Options(max_samples=np.int64(1000))
+    assert o.max_samples == 1000 and isinstance(o.max_samples, int)
+    out = sweep([s], 1e-3, threads=np.int64(1), max_samples=np.int32(100))
+    assert out[0].ok
+    with pytest.raises(rvdyn.ParameterError, match="threads"):
+        sweep([s], 1e-3, threads=1.5)  # type: ignore[arg-type]
+    with pytest.raises(rvdyn.ParameterError, match="threads"):
+        sweep([s], 1e-3, threads=0)
+
+
+def test_scene_values_may_be_numpy_numbers() -> None:
+    s = Scene.paper("rated").replace(**{"cranks": np.int64(3), "load.torque": np.float32(1e4),
+                                        "pin_errors.radius": np.zeros(24)})
+    assert s["cranks"] == 3 and s["load.torque"] == 1e4 and s["pin_errors.radius"] == [0.0] * 24
+    with pytest.raises(rvdyn.SceneError, match="not a number"):
+        Scene.paper().replace(**{"load.torque": object()})
+    with pytest.raises(rvdyn.SceneError, match="NaN"):
+        Scene.paper().replace(**{"load.torque": np.float64("nan")})
