@@ -41,12 +41,12 @@ class DynamicKernel:
     """A dynamic run of ``t_end`` [s] reduced to :data:`DYNAMIC_METRICS`.
 
     t_start: start of the evaluated window [s] (default 20 % of t_end, after the start-up
-    transient). integrator, dt: as for :func:`rvdyn.simulate`. Only the motion, pin and mesh
+    transient). integrator, dt: as for :func:`rvdyn.simulate` (None: its defaults). Only the motion, pin and mesh
     channels are recorded."""
 
     t_end: float = 0.5
     t_start: float | None = None
-    integrator: str = "generalized-alpha"
+    integrator: str | None = None
     dt: float | None = None
     name: str = field(default="dynamic", init=False)
 
