@@ -16,7 +16,6 @@ import concurrent.futures
 import json
 import multiprocessing
 import os
-import resource
 import statistics
 import subprocess
 import sys
@@ -134,10 +133,25 @@ def part_overhead(n: int, rounds: int) -> dict[str, Any]:
 _MEMORY_CHILD = """
 import resource, sys, tempfile, time, os, json
 sys.path.insert(0, {bench_dir!r})
+
+
+def hwm():
+    # Peak RSS of this process [KiB]: VmHWM (reset by exec, unlike ru_maxrss, which Linux
+    # carries over from the forking parent).
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1])
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+
+
 import study_throughput as b
 import rvdyn
 from rvdyn.study import FunctionKernel, MonteCarlo
-base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+base = hwm()
 with tempfile.TemporaryDirectory() as d:
     t = time.perf_counter()
     path = rvdyn.study(b.SCENE, FunctionKernel(b.cheap, ("d_sum", "r_max", "r_min")), b.TOLS,
@@ -145,7 +159,7 @@ with tempfile.TemporaryDirectory() as d:
                        chunk_size=5000, batch_size=100, load={load})
     wall = time.perf_counter() - t
     size = sum(os.path.getsize(os.path.join(d, "s.parquet", f)) for f in os.listdir(os.path.join(d, "s.parquet")))
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+peak = hwm()
 print(json.dumps({{"n": {n}, "load": {load}, "baseline_MiB": base / 1024, "peak_MiB": peak / 1024,
                   "wall_s": wall, "disk_MiB": size / 2**20}}))
 """
