@@ -10,7 +10,10 @@
 use super::errors::{chained, parameter_error};
 use crate::error::{RvdynError, try_vec};
 use numpy::ndarray::{ArrayD, IxDyn, Slice};
-use numpy::{AllowTypeChange, IntoPyArray, PyArrayLikeDyn, PyUntypedArrayMethods};
+use numpy::{
+    AllowTypeChange, IntoPyArray, PyArrayDescrMethods, PyArrayLikeDyn, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyFloat;
@@ -124,6 +127,29 @@ impl<'a, 'py> FromPyObject<'a, 'py> for FloatArray<'py> {
             return Err(PyTypeError::new_err(
                 "expected a number or an array of numbers, got None",
             ));
+        }
+        if ob.is_instance_of::<pyo3::types::PyString>()
+            || ob.is_instance_of::<pyo3::types::PyBytes>()
+        {
+            return Err(PyTypeError::new_err(format!(
+                "expected a number or an array of numbers, got {}",
+                short_repr(&ob, 40)
+            )));
+        }
+        // numpy would cast complex (dropping the imaginary part with only a warning), dates
+        // and strings to float: only booleans, integers and reals are numbers here.
+        if let Ok(array) = ob.cast::<PyUntypedArray>() {
+            let dtype = array.dtype();
+            let kind = dtype.kind();
+            if !matches!(kind, b'b' | b'i' | b'u' | b'f') {
+                return Err(PyTypeError::new_err(format!(
+                    "expected an array of real numbers, got an array of dtype {}",
+                    dtype
+                        .str()
+                        .map(|s| s.to_string())
+                        .unwrap_or_else(|_| "?".into())
+                )));
+            }
         }
         match ob.extract::<PyArrayLikeDyn<'py, f64, AllowTypeChange>>() {
             Ok(a) => Ok(FloatArray(a)),

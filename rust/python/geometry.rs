@@ -5,6 +5,7 @@ use super::{
     Broadcast, FloatArray, Input, Real, Whole, count, output, parameter_error, point2, python_type,
     vec2,
 };
+use crate::error::RvdynError;
 use crate::geometry::cycloid::CycloidParams;
 use crate::geometry::mass::{DiscHoles, STEEL_DENSITY, disc_mass_properties};
 use crate::geometry::{CycloidGeometry, InvoluteStage, PinGap};
@@ -72,7 +73,7 @@ impl PyCycloidGeometry {
         py: Python<'py>,
         what: &str,
         phi: &FloatArray<'py>,
-        f: impl Fn(&CycloidGeometry, f64) -> [f64; N] + Send + Sync,
+        f: impl Fn(&CycloidGeometry, f64) -> Result<[f64; N], RvdynError> + Send + Sync,
     ) -> PyResult<Bound<'py, PyAny>> {
         let input = Input::finite("phi", "rad", phi)?;
         let mut shape = input.shape.clone();
@@ -82,8 +83,23 @@ impl PyCycloidGeometry {
         check_ndim(&format!("the result of {what}"), shape.len())?;
         let b = Broadcast::new(vec![("phi", input)])?;
         let g = &self.inner;
-        let values = py.detach(|| b.map_rows::<N>(what, |x| Ok(f(g, x[0]))))?;
+        let values = py.detach(|| b.map_rows::<N>(what, |x| f(g, x[0])))?;
         output(py, &shape, values)
+    }
+}
+
+/// A radius of curvature, or a `GeometryError` where the profile is straight (the pin-centre
+/// curve has an inflection exactly at `phi`, e.g. the root of a disc with K1 = 1/zp): the
+/// radius is infinite there.
+fn finite_curvature_radius(radius: f64, phi: f64) -> Result<[f64; 1], RvdynError> {
+    if radius.is_finite() {
+        Ok([radius])
+    } else {
+        Err(RvdynError::Geometry(format!(
+            "the profile is straight at phi = {} rad (an inflection of the pin-centre curve, \
+             e.g. the root of a disc with K1 = 1/zp): its radius of curvature is infinite",
+            crate::error::num(phi)
+        )))
     }
 }
 
@@ -99,6 +115,9 @@ fn gap_result<'py>(py: Python<'py>, g: &PinGap) -> PyResult<Bound<'py, PyAny>> {
         g.phi,
         g.curvature_radius,
     ];
+    if !g.curvature_radius.is_finite() && fields[..6].iter().all(|v| v.is_finite()) {
+        finite_curvature_radius(g.curvature_radius, g.phi)?;
+    }
     if fields.iter().any(|v| !v.is_finite()) {
         return Err(parameter_error(
             "the gap is not finite for these inputs: they are beyond the range the formulas \
@@ -229,7 +248,7 @@ impl PyCycloidGeometry {
     /// numpy.ndarray, shape phi.shape + (2,)
     ///     (x, y) [m]; shape (2,) for a scalar phi, (n, 2) for n angles.
     fn profile<'py>(&self, py: Python<'py>, phi: FloatArray<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.map_angles::<2>(py, "profile", &phi, |g, p| g.profile_point(p))
+        self.map_angles::<2>(py, "profile", &phi, |g, p| Ok(g.profile_point(p)))
     }
 
     /// Outward unit normals of the profile, disc frame.
@@ -244,7 +263,7 @@ impl PyCycloidGeometry {
     /// numpy.ndarray, shape phi.shape + (2,)
     ///     Unit vectors (x, y) [-], pointing from the disc material to the pins.
     fn normal<'py>(&self, py: Python<'py>, phi: FloatArray<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.map_angles::<2>(py, "normal", &phi, |g, p| g.normal(p))
+        self.map_angles::<2>(py, "normal", &phi, |g, p| Ok(g.normal(p)))
     }
 
     /// Signed radius of curvature of the profile [m]: positive where convex (lobe flanks and
@@ -265,7 +284,9 @@ impl PyCycloidGeometry {
         py: Python<'py>,
         phi: FloatArray<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.map_angles::<1>(py, "curvature_radius", &phi, |g, p| [g.curvature_radius(p)])
+        self.map_angles::<1>(py, "curvature_radius", &phi, |g, p| {
+            finite_curvature_radius(g.curvature_radius(p), p)
+        })
     }
 
     /// Exact signed gap between one pin and the profile of this disc placed in the fixed frame.
