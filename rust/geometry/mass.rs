@@ -33,7 +33,9 @@ pub fn require_density(density: f64) -> Result<f64> {
 /// Mass [kg] and moment of inertia about the body's own axis [kg m^2].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MassProperties {
+    /// Mass [kg].
     pub mass: f64,
+    /// Moment of inertia about the body's own axis [kg m^2].
     pub inertia: f64,
 }
 
@@ -46,9 +48,11 @@ pub struct DiscHoles {
     pub hole_circle_radius: f64,
     /// Number of crank (eccentric bearing) holes and their radius [m].
     pub crank_holes: u32,
+    /// Radius of each crank hole [m].
     pub crank_hole_radius: f64,
     /// Number of pillar holes (between the crank holes) and their radius [m].
     pub pillar_holes: u32,
+    /// Radius of each pillar hole [m].
     pub pillar_hole_radius: f64,
 }
 
