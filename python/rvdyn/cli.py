@@ -6,6 +6,7 @@ Subcommands::
     rvdyn plot-geometry [--out DIR] [--psi RAD]
     rvdyn plot-stiffness [--out DIR]
     rvdyn paper [--out DIR] [--t-end S] [--load {idle,paper,rated,all}] [--integrator NAME]
+    rvdyn study SPEC.toml [--out DIR] [--samples N] [--no-plots]
 
 Each subcommand is one entry of :data:`COMMANDS` (name, help, arguments, handler): to add a
 subcommand, write ``_add_x(parser)`` and ``_run_x(args) -> int`` and append one
@@ -346,6 +347,27 @@ def _run_paper(args: argparse.Namespace) -> int:
     return int(result) if result is not None else 0
 
 
+# ---------------------------------------------------------------------------------------------
+# study (rvdyn.study.config)
+
+
+def _add_study(p: argparse.ArgumentParser) -> None:
+    p.add_argument("spec", metavar="SPEC.toml", help="study spec (format: help(rvdyn.study.config))")
+    p.add_argument("--out", default=None, metavar="DIR", help="output folder (default: the spec's [output] dir)")
+    p.add_argument("--samples", type=int, default=None, metavar="N", help="override the number of samples")
+    p.add_argument("--no-plots", action="store_true", help="do not draw the figures")
+
+
+def _run_study(args: argparse.Namespace) -> int:
+    from .study.config import run_spec
+
+    res = run_spec(args.spec, out=args.out, samples=args.samples, plots=not args.no_plots)
+    y = res.get("yield")
+    print(f"rvdyn study: {res['samples']} samples, {res['failed']} failed"
+          + (f"; yield {y['rate']['value']:.4g} [{y['rate']['low']:.4g}, {y['rate']['high']:.4g}]" if y else ""))
+    return 0
+
+
 COMMANDS: list[Command] = [
     Command("info", "print the default scene's kinematics, loads, geometry and stiffness",
             _add_info, _run_info),
@@ -355,6 +377,8 @@ COMMANDS: list[Command] = [
             _add_plot_stiffness, _run_plot_stiffness),
     Command("paper", "run the paper's simulations on the default scene and write figures",
             _add_paper, _run_paper),
+    Command("study", "run a tolerance study from a TOML spec (table, statistics, plots)", _add_study,
+            _run_study),
 ]
 
 
