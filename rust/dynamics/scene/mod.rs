@@ -6,6 +6,7 @@
 pub mod schema;
 
 use crate::contact::ImpactLaw;
+use crate::contact::law::{ContactDamping, DampingSpec, IsoMesh, MeshLaw, PinLaw, scene_material};
 use crate::error::{Result, RvdynError};
 use crate::geometry::cycloid::CycloidParams;
 use crate::geometry::involute::InvoluteStage;
@@ -43,6 +44,71 @@ pub struct PinErrors {
     pub radius: Vec<f64>,
 }
 
+/// Manufacturing and assembly errors of the cranks, discs and carrier (SI; compliant joints
+/// only: with ideal joints they would over-constrain the discs). Empty lists mean no error.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AssemblyErrors {
+    /// Eccentricity error of each crank [m] (`e -> e + de_i`, both eccentrics of the crank).
+    #[serde(default)]
+    pub crank_eccentricity: Vec<f64>,
+    /// Phase error of each crank's eccentrics [rad].
+    #[serde(default)]
+    pub crank_phase: Vec<f64>,
+    /// Position error of each crank hole in each disc, `[crank][disc]` flattened as
+    /// `crank * discs + disc`, (dx, dy) in the disc frame [m].
+    #[serde(default)]
+    pub disc_holes: Vec<[f64; 2]>,
+    /// Position error of each crank seat in the carrier, (dx, dy) in the carrier frame [m].
+    #[serde(default)]
+    pub carrier_seats: Vec<[f64; 2]>,
+}
+
+impl AssemblyErrors {
+    /// Whether any error is given.
+    pub fn any(&self) -> bool {
+        !(self.crank_eccentricity.is_empty()
+            && self.crank_phase.is_empty()
+            && self.disc_holes.is_empty()
+            && self.carrier_seats.is_empty())
+    }
+
+    /// Check lengths (`cranks`, `cranks * discs`), finiteness, and that an eccentricity error
+    /// stays below the eccentricity `e` [m] in magnitude.
+    pub fn check(&self, cranks: usize, discs: usize, e: f64) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Scene(m));
+        for (n, len, want) in [
+            ("crank_eccentricity", self.crank_eccentricity.len(), cranks),
+            ("crank_phase", self.crank_phase.len(), cranks),
+            ("disc_holes", self.disc_holes.len(), cranks * discs),
+            ("carrier_seats", self.carrier_seats.len(), cranks),
+        ] {
+            if len != 0 && len != want {
+                return bad(format!(
+                    "errors.{n} must be empty or have {want} entries, got {len}"
+                ));
+            }
+        }
+        let finite = self
+            .crank_eccentricity
+            .iter()
+            .chain(&self.crank_phase)
+            .chain(self.disc_holes.iter().flatten())
+            .chain(self.carrier_seats.iter().flatten())
+            .all(|v| v.is_finite());
+        if !finite {
+            return bad("errors must be finite numbers (m, rad)".into());
+        }
+        if let Some(de) = self.crank_eccentricity.iter().find(|d| d.abs() >= e) {
+            return bad(format!(
+                "errors.crank_eccentricity {de} m must be smaller in magnitude than the \
+                 eccentricity {e} m"
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Mass properties of the bodies; `None` = computed from the geometry (steel).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -64,17 +130,103 @@ pub struct Inertias {
     pub load_inertia: f64,
 }
 
-/// A bearing spring-damper (compliant joints).
+/// A bearing spring-damper (compliant joints): linear (`stiffness`, `damping`), or built from
+/// its rollers (`rollers`), with `stiffness` and `damping` then a linear spring-damper in
+/// parallel (0 for none; same clearance).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Bearing {
-    /// Radial stiffness [N/m].
+    /// Radial stiffness [N/m] (with rollers: a parallel linear spring, 0 for none).
     pub stiffness: f64,
-    /// Radial damping [N s/m].
+    /// Radial damping [N s/m] (with rollers: a parallel damper, 0 for none).
     pub damping: f64,
-    /// Radial clearance [m].
+    /// Radial clearance per side [m].
     #[serde(default)]
     pub clearance: f64,
+    /// Roller (needle) bearing: nonlinear load-deflection from its rollers (Palmgren line
+    /// contact per roller at both raceways; `bearing::roller`).
+    #[serde(default)]
+    pub rollers: Option<Rollers>,
+}
+
+/// The rollers of a roller bearing (SI).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Rollers {
+    /// Number of rollers (at least 3).
+    pub count: u32,
+    /// Effective roller length [m].
+    pub length: f64,
+    /// Roller diameter [m] (for the ISO 281 load rating).
+    pub diameter: f64,
+    /// Pitch diameter of the roller set [m] (for the load rating).
+    pub pitch_diameter: f64,
+    /// Damping ratio [-] of the stiffness-proportional roller damping, referred to
+    /// `frequency`: each roller pushes with `max(0, Q + beta k delta')`,
+    /// `beta = 2 damping_ratio / (2 pi frequency)`.
+    pub damping_ratio: f64,
+    /// Reference frequency of the damping ratio [Hz].
+    pub frequency: f64,
+}
+
+impl Rollers {
+    /// The roller load-deflection law with the bearing's clearance [m].
+    pub fn bearing(&self, clearance: f64) -> Result<crate::bearing::RollerBearing> {
+        crate::bearing::RollerBearing::new(self.count as usize, self.length, clearance)
+    }
+
+    /// `beta` [s] of the roller damping.
+    pub fn beta(&self) -> f64 {
+        2.0 * self.damping_ratio / (std::f64::consts::TAU * self.frequency)
+    }
+
+    /// ISO 281 basic dynamic load rating [N] (one row, `b_m = 1.1`).
+    pub fn load_rating(&self) -> Result<f64> {
+        crate::bearing::RollerBearingGeometry {
+            rollers: self.count,
+            rows: 1,
+            roller_diameter: self.diameter,
+            roller_length: self.length,
+            pitch_diameter: self.pitch_diameter,
+            contact_angle: 0.0,
+            rating_factor: crate::bearing::life::BM_ROLLER,
+        }
+        .dynamic_load_rating()
+    }
+
+    /// Check the fields, naming `at` (e.g. `"joints.eccentric_bearing"`) in the message.
+    pub fn check(&self, at: &str) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Scene(format!("{at}.rollers: {m}")));
+        if self.count < 3 {
+            return bad(format!(
+                "count must be at least 3 rollers, got {}",
+                self.count
+            ));
+        }
+        for (n, v) in [
+            ("length", self.length),
+            ("diameter", self.diameter),
+            ("pitch_diameter", self.pitch_diameter),
+            ("frequency", self.frequency),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(format!("{n} must be > 0, got {v}"));
+            }
+        }
+        if self.diameter >= self.pitch_diameter {
+            return bad(format!(
+                "diameter {} m must be below pitch_diameter {} m",
+                self.diameter, self.pitch_diameter
+            ));
+        }
+        if !(self.damping_ratio.is_finite() && (0.0..1.0).contains(&self.damping_ratio)) {
+            return bad(format!(
+                "damping_ratio must be in [0, 1), got {}",
+                self.damping_ratio
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Crank-eccentric/disc and crank/carrier bearings.
@@ -121,6 +273,32 @@ pub enum ContactLawSpec {
         /// Penetration at which the full damping acts [m].
         damping_depth: f64,
     },
+    /// Pins only: line contact of the pin and the local profile curvature (Johnson; see
+    /// `contact::line_contact`), materials of pin and disc, and a damping law.
+    Line {
+        /// Young's modulus of pins and discs [Pa] (default the paper's 2.17e11).
+        #[serde(default = "crate::contact::law::default_youngs_modulus")]
+        youngs_modulus: f64,
+        /// Poisson's ratio [-] (default 0.3).
+        #[serde(default = "crate::contact::law::default_poisson_ratio")]
+        poisson_ratio: f64,
+        /// Damping of the contacts.
+        damping: DampingSpec,
+    },
+    /// Meshes only: ISO 6336-1 method B stiffness, varying along the line of action with the
+    /// single- and double-tooth zones (`gear::iso6336`), and a damping law.
+    Iso6336 {
+        /// Width of the smoothing ramps at the zone boundaries, fraction of a base pitch
+        /// (default 0.02; 0 for jumps).
+        #[serde(default = "default_mesh_ramp")]
+        ramp: f64,
+        /// Damping of the meshes.
+        damping: DampingSpec,
+    },
+}
+
+fn default_mesh_ramp() -> f64 {
+    0.02
 }
 
 impl ContactLawSpec {
@@ -136,7 +314,9 @@ impl ContactLawSpec {
         }
     }
 
-    /// The force law for a contact of length `face_width` [m].
+    /// The IMPACT-type law for a contact of length `face_width` [m] (`impact` and `palmgren`).
+    ///
+    /// Errors (`Scene`) for `line` and `iso6336`, which are not IMPACT laws.
     pub fn law(&self, face_width: f64) -> Result<ImpactLaw> {
         match *self {
             ContactLawSpec::Impact {
@@ -154,6 +334,64 @@ impl ContactLawSpec {
                 let k = (1e3 * l_mm.powf(0.8) / 3.84e-5).powf(1.0 / 0.9);
                 ImpactLaw::new(k, 1.0 / 0.9, max_damping, damping_depth)
             }
+            ContactLawSpec::Line { .. } | ContactLawSpec::Iso6336 { .. } => Err(RvdynError::Scene(
+                "this contact law is not an IMPACT-type law (line and iso6336 are built \
+                     from the geometry)"
+                    .into(),
+            )),
+        }
+    }
+
+    /// The pin/disc law for discs of face width `face_width` [m].
+    ///
+    /// Errors (`Scene`) for `iso6336` (a mesh law) and invalid parameters.
+    pub fn pin_law(&self, face_width: f64) -> Result<PinLaw> {
+        match *self {
+            ContactLawSpec::Line {
+                youngs_modulus,
+                poisson_ratio,
+                damping,
+            } => {
+                let m = scene_material("pin", youngs_modulus, poisson_ratio)?;
+                Ok(PinLaw::Line {
+                    pin: m,
+                    disc: m,
+                    damping: ContactDamping::new(&damping)
+                        .map_err(|e| RvdynError::Scene(format!("contact.pin.damping: {e}")))?,
+                })
+            }
+            ContactLawSpec::Iso6336 { .. } => Err(RvdynError::Scene(
+                "contact.pin cannot be \"iso6336\" (a gear mesh law); use \"line\", \
+                 \"impact\" or \"palmgren\""
+                    .into(),
+            )),
+            _ => Ok(PinLaw::Impact(self.law(face_width)?)),
+        }
+    }
+
+    /// The sun/planet mesh law for the stage `stage`.
+    ///
+    /// Errors (`Scene`) for `line` (a pin law) and invalid parameters.
+    pub fn mesh_law(&self, stage: &InvoluteStage) -> Result<MeshLaw> {
+        match *self {
+            ContactLawSpec::Iso6336 { ramp, damping } => Ok(MeshLaw::Iso(
+                IsoMesh::new(
+                    stage.z_sun,
+                    stage.z_planet,
+                    stage.module,
+                    stage.pressure_angle,
+                    stage.face_width,
+                    ramp,
+                    &damping,
+                )
+                .map_err(|e| RvdynError::Scene(format!("contact.mesh: {e}")))?,
+            )),
+            ContactLawSpec::Line { .. } => Err(RvdynError::Scene(
+                "contact.mesh cannot be \"line\" (the pin/disc law); use \"iso6336\", \
+                 \"impact\" or \"palmgren\""
+                    .into(),
+            )),
+            _ => Ok(MeshLaw::Impact(self.law(stage.face_width)?)),
         }
     }
 }
@@ -166,6 +404,99 @@ pub struct ContactLaws {
     pub pin: ContactLawSpec,
     /// Sun / planet meshes (along the line of action).
     pub mesh: ContactLawSpec,
+}
+
+/// Friction in the reducer (all zero by default: frictionless, as the paper).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Friction {
+    /// Coulomb coefficient at the pin/disc contacts [-], in [0, 1].
+    #[serde(default)]
+    pub pin: f64,
+    /// Pins that roll in the housing: the sliding moves to the pin/housing contact, at the
+    /// radius `pin_rolling * rrp` (1 for a pin in a groove of its own radius, less for a
+    /// sleeve on a journal); the tangential force on the disc is then `pin * pin_rolling * N`.
+    /// `None`: pins fixed, sliding at the disc.
+    #[serde(default)]
+    pub pin_rolling: Option<f64>,
+    /// Coulomb coefficient at the sun/planet teeth [-], in [0, 1] (sliding along the tooth).
+    #[serde(default)]
+    pub mesh: f64,
+    /// Regularisation speed of the Coulomb law [m/s] (`contact::friction`): default 1e-3.
+    #[serde(default = "default_regularisation_speed")]
+    pub regularisation_speed: f64,
+    /// Palmgren friction torque of the joint bearings (compliant joints only).
+    #[serde(default)]
+    pub bearing: Option<BearingFriction>,
+}
+
+fn default_regularisation_speed() -> f64 {
+    1e-3
+}
+
+impl Default for Friction {
+    fn default() -> Self {
+        Self {
+            pin: 0.0,
+            pin_rolling: None,
+            mesh: 0.0,
+            regularisation_speed: default_regularisation_speed(),
+            bearing: None,
+        }
+    }
+}
+
+impl Friction {
+    /// Whether any friction acts.
+    pub fn any(&self) -> bool {
+        self.pin > 0.0 || self.mesh > 0.0 || self.bearing.is_some()
+    }
+
+    /// Check the fields; errors name the field and its limits.
+    pub fn check(&self) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Scene(m));
+        for (n, mu) in [("pin", self.pin), ("mesh", self.mesh)] {
+            if !(mu.is_finite() && (0.0..=1.0).contains(&mu)) {
+                return bad(format!(
+                    "friction.{n} must be a friction coefficient in [0, 1], got {mu}"
+                ));
+            }
+        }
+        if let Some(l) = self.pin_rolling
+            && !(l.is_finite() && l > 0.0 && l <= 1.0)
+        {
+            return bad(format!(
+                "friction.pin_rolling must be a lever ratio in (0, 1], got {l}"
+            ));
+        }
+        let v = self.regularisation_speed;
+        if !(v.is_finite() && v > 0.0) {
+            return bad(format!(
+                "friction.regularisation_speed must be > 0 m/s, got {v}"
+            ));
+        }
+        if let Some(b) = &self.bearing {
+            for (n, x) in [("f0", b.f0), ("f1", b.f1), ("viscosity", b.viscosity)] {
+                if !(x.is_finite() && x >= 0.0) {
+                    return bad(format!("friction.bearing.{n} must be >= 0, got {x}"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Palmgren bearing friction coefficients (`bearing::PalmgrenFriction`); the pitch diameters
+/// come from the bearings' rollers (linear bearings: 50 mm assumed).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BearingFriction {
+    /// Load-independent factor `f0` [-].
+    pub f0: f64,
+    /// Load factor `f1` [-].
+    pub f1: f64,
+    /// Oil kinematic viscosity [m^2/s].
+    pub viscosity: f64,
 }
 
 /// How the input starts.
@@ -308,12 +639,58 @@ pub struct Scene {
     pub joints: Joints,
     /// Contact laws of the pins and meshes.
     pub contact: ContactLaws,
+    /// Friction (default: none).
+    #[serde(default)]
+    pub friction: Friction,
+    /// Manufacturing and assembly errors of cranks, discs and carrier (default: none).
+    #[serde(default)]
+    pub errors: AssemblyErrors,
     /// The input drive.
     pub drive: Drive,
     /// The load on the output.
     pub load: Load,
     /// Initial state.
     pub initial: Initial,
+}
+
+/// Damping ratio of the physical preset's contacts, meshes and bearings [-], referred to
+/// [`PHYSICAL_REFERENCE_FREQUENCY`]: a few per cent, as measured for lubricated steel gear
+/// meshes (docs/model.md, "Damping").
+pub const PHYSICAL_DAMPING_RATIO: f64 = 0.05;
+
+/// Reference frequency of the physical preset's damping [Hz]: its main torsional mode at rated
+/// load (linearised model, docs/model.md), so that this mode has the damping ratio
+/// [`PHYSICAL_DAMPING_RATIO`].
+pub const PHYSICAL_REFERENCE_FREQUENCY: f64 = 1670.0;
+
+/// Joints of the physical preset (assumed sizes, stated): on each eccentric a needle bearing
+/// in the 50 mm disc hole, 26 rollers of 5 mm x 30 mm on a 45 mm pitch diameter, 5 um radial
+/// clearance; each crankshaft in the carrier on two roller bearings lumped as one row of
+/// 20 rollers of 7 mm x 24 mm on a 50 mm pitch diameter, 5 um radial clearance. Roller damping
+/// as the contacts.
+pub fn physical_joints() -> Joints {
+    let rollers = |count, length, diameter, pitch_diameter| Rollers {
+        count,
+        length,
+        diameter,
+        pitch_diameter,
+        damping_ratio: PHYSICAL_DAMPING_RATIO,
+        frequency: PHYSICAL_REFERENCE_FREQUENCY,
+    };
+    Joints::Compliant {
+        eccentric_bearing: Bearing {
+            stiffness: 0.0,
+            damping: 0.0,
+            clearance: 5e-6,
+            rollers: Some(rollers(26, 0.030, 0.005, 0.045)),
+        },
+        crank_bearing: Some(Bearing {
+            stiffness: 0.0,
+            damping: 0.0,
+            clearance: 5e-6,
+            rollers: Some(rollers(20, 0.024, 0.007, 0.050)),
+        }),
+    }
 }
 
 /// The paper's input speed, 8328 deg/s [rad/s].
@@ -369,6 +746,8 @@ impl Scene {
             density: crate::geometry::mass::STEEL_DENSITY,
             inertias: Inertias::default(),
             joints: Joints::Rigid,
+            friction: Friction::default(),
+            errors: AssemblyErrors::default(),
             contact: ContactLaws {
                 pin: ContactLawSpec::paper(),
                 mesh: ContactLawSpec::paper(),
@@ -381,6 +760,43 @@ impl Scene {
             load,
             initial: Initial::Rest,
         })
+    }
+
+    /// The physical preset: the paper's reducer and load case (`"idle"`, `"paper"`, `"rated"`)
+    /// with the physics derived from geometry and materials instead of the paper's laws:
+    /// - pins: line contact from the local profile curvature (Johnson), steel;
+    /// - meshes: ISO 6336-1 method B stiffness varying along the line of action;
+    /// - damping: stiffness-proportional, damping ratio [`PHYSICAL_DAMPING_RATIO`] at
+    ///   [`PHYSICAL_REFERENCE_FREQUENCY`] (the main torsional mode of this preset);
+    /// - joints: needle bearings on the eccentrics and roller bearings in the carrier, built
+    ///   from their rollers (Palmgren) with radial clearance (see [`physical_joints`]);
+    /// - drive: the paper's input speed reached by a smooth ramp over 50 ms from rest.
+    pub fn physical(load: &str) -> Result<Self> {
+        let mut s = Self::paper(load)?;
+        s.name = "physical".into();
+        let damping = DampingSpec::DampingRatio {
+            ratio: PHYSICAL_DAMPING_RATIO,
+            frequency: PHYSICAL_REFERENCE_FREQUENCY,
+        };
+        s.contact = ContactLaws {
+            pin: ContactLawSpec::Line {
+                youngs_modulus: crate::contact::law::default_youngs_modulus(),
+                poisson_ratio: crate::contact::law::default_poisson_ratio(),
+                damping,
+            },
+            mesh: ContactLawSpec::Iso6336 {
+                ramp: default_mesh_ramp(),
+                damping,
+            },
+        };
+        s.joints = physical_joints();
+        s.drive = Drive::Speed {
+            speed: PAPER_INPUT_SPEED,
+            start: StartKind::Ramp,
+            ramp_time: 0.05,
+        };
+        s.validate()?;
+        Ok(s)
     }
 
     /// Parse a scene from JSON text.
@@ -536,12 +952,30 @@ impl Scene {
             .into_iter()
             .filter_map(|(n, b)| b.map(|b| (n, b)))
             {
-                if !(b.stiffness.is_finite()
+                if !(b.clearance.is_finite() && b.clearance >= 0.0) {
+                    return err(format!(
+                        "joints.{n}.clearance must be >= 0 m (no preload), got {}",
+                        b.clearance
+                    ));
+                }
+                if let Some(r) = &b.rollers {
+                    r.check(&format!("joints.{n}"))?;
+                    if !(b.stiffness.is_finite()
+                        && b.stiffness >= 0.0
+                        && b.damping.is_finite()
+                        && b.damping >= 0.0)
+                    {
+                        return err(format!(
+                            "joints.{n} has rollers: stiffness and damping (a linear \
+                             spring-damper in parallel, 0 for none) must be >= 0, got {} N/m \
+                             and {} N s/m",
+                            b.stiffness, b.damping
+                        ));
+                    }
+                } else if !(b.stiffness.is_finite()
                     && b.stiffness > 0.0
                     && b.damping.is_finite()
-                    && b.damping >= 0.0
-                    && b.clearance.is_finite()
-                    && b.clearance >= 0.0)
+                    && b.damping >= 0.0)
                 {
                     return err(format!(
                         "joints.{n} needs stiffness > 0 N/m, damping >= 0 N s/m, clearance >= 0 m; got {b:?}"
@@ -549,9 +983,49 @@ impl Scene {
                 }
             }
         }
-        self.contact.pin.law(self.cycloid.face_width)?;
+        self.friction.check()?;
+        self.errors.check(
+            self.cranks as usize,
+            self.discs.len(),
+            self.cycloid.eccentricity,
+        )?;
+        if self.errors.any() && matches!(self.joints, Joints::Rigid) {
+            return err(
+                "errors (crank, hole and seat errors) need compliant joints: with ideal joints \
+                 they over-constrain the discs; set joints.kind = \"compliant\""
+                    .into(),
+            );
+        }
+        self.contact.pin.pin_law(self.cycloid.face_width)?;
+        if matches!(self.contact.pin, ContactLawSpec::Line { .. }) {
+            // The line law needs 1/r_pin + kappa_profile > 0 along the whole profile (a concave
+            // root flatter than the pin); check the most concave point, the root, on a fine
+            // sample of one lobe of every disc, with the largest pin.
+            let r_pin = self.cycloid.pin_radius
+                + self.pin_errors.radius.iter().cloned().fold(0.0, f64::max);
+            for k in 0..self.discs.len() {
+                let g = crate::geometry::CycloidGeometry::new(self.disc_params(k))?;
+                let lobe = std::f64::consts::TAU / f64::from(g.lobes());
+                for i in 0..=256 {
+                    let phi = lobe * (f64::from(i) / 256.0 - 0.5);
+                    let kp = crate::contact::line_contact::pin_disc_profile_curvature(
+                        g.centre_curve_curvature(phi),
+                        g.generating_pin_radius(),
+                    )?;
+                    if 1.0 / r_pin + kp <= 0.0 {
+                        return err(format!(
+                            "contact.pin = \"line\": disc {k}'s profile is more concave ({:.4e} m \
+                             radius at curve parameter {phi:.4} rad) than a pin of radius \
+                             {r_pin} m is convex: the pin would sit in a conformal or nested \
+                             seat, not a Hertz line contact",
+                            1.0 / kp
+                        ));
+                    }
+                }
+            }
+        }
         if let Some(s) = &self.stage1 {
-            self.contact.mesh.law(s.face_width)?;
+            self.contact.mesh.mesh_law(s)?;
         }
         match self.drive {
             Drive::Speed {
