@@ -81,6 +81,36 @@ impl CompiledScene {
         Ok(Self::new(Scene::paper(load)?)?)
     }
 
+    /// The physical preset (docs/model.md#the-physical-preset): the paper's reducer with line
+    /// contact pins, ISO 6336 meshes, roller bearings and 5 % modal damping; `load` as for
+    /// `paper`.
+    #[staticmethod]
+    fn physical(load: &str) -> PyResult<Self> {
+        Ok(Self::new(Scene::physical(load)?)?)
+    }
+
+    /// ISO 281 basic dynamic load ratings [N] of the eccentric and the crank bearings that are
+    /// built from rollers (`None` for a linear bearing, rigid crank bearings or ideal joints).
+    fn bearing_ratings(&self) -> PyResult<(Option<f64>, Option<f64>)> {
+        use crate::dynamics::scene::Joints;
+        let rating = |b: Option<&crate::dynamics::scene::Bearing>| -> PyResult<Option<f64>> {
+            match b.and_then(|b| b.rollers) {
+                Some(r) => Ok(Some(r.load_rating()?)),
+                None => Ok(None),
+            }
+        };
+        match &self.scene.joints {
+            Joints::Rigid => Ok((None, None)),
+            Joints::Compliant {
+                eccentric_bearing,
+                crank_bearing,
+            } => Ok((
+                rating(Some(eccentric_bearing))?,
+                rating(crank_bearing.as_ref())?,
+            )),
+        }
+    }
+
     /// The scene as JSON text (pretty when `indent`).
     #[pyo3(signature = (indent = true))]
     fn to_json(&self, indent: bool) -> PyResult<String> {

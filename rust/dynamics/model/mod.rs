@@ -57,6 +57,8 @@ pub struct Observation {
     pub kinetic_energy: f64,
     /// Elastic energy of the contacts and bearings [J].
     pub potential_energy: f64,
+    /// Friction power [W] at the pins, the teeth and the bearings.
+    pub friction_power: [f64; 3],
 }
 
 /// A reducer model the driver can integrate and record.

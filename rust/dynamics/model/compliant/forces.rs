@@ -45,6 +45,7 @@ impl CompliantModel {
             // Crank bearing: force on the crank centre, reaction on the carrier at s_i.
             if let Some(cb) = &self.crank_bearing {
                 let b = cb.load(sub(p, s_act), sub(pv, scaled(vc, perp(s_act))));
+                sink.bearing(0, i, b.force);
                 qf[ci] += b.force[0];
                 qf[ci + 1] += b.force[1];
                 qf[CARRIER] -= cross(s_act, b.force);
@@ -75,6 +76,7 @@ impl CompliantModel {
                 let h_v = add(ov, scaled(v[dk + 2], perp(arm)));
                 let b = self.eccentric_bearing.load(sub(h, e_pos), sub(h_v, e_v));
                 let f = b.force;
+                sink.bearing(1, i * nd + k, f);
                 qf[dk] += f[0];
                 qf[dk + 1] += f[1];
                 qf[dk + 2] += cross(arm, f);

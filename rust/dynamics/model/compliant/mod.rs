@@ -516,6 +516,7 @@ impl ReducerModel for CompliantModel {
             input_torque,
             kinetic_energy: self.kinetic_energy(&xv),
             potential_energy: flows.potential,
+            friction_power: flows.friction,
         })
     }
 }
