@@ -326,6 +326,8 @@ class CompiledScene:
     @staticmethod
     def physical(load: str) -> CompiledScene:
         """The physical preset; load is "idle", "paper" or "rated"."""
+    def physics_summary(self) -> str:
+        """The contact physics at the rated operating point, as JSON text."""
     def bearing_ratings(self) -> tuple[float | None, float | None]:
         """ISO 281 load ratings [N] of the eccentric and crank roller bearings (None if linear)."""
     def to_json(self, indent: bool = True) -> str:

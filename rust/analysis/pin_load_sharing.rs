@@ -267,3 +267,142 @@ mod tests {
         assert!(line_law_load_sharing(&g, f64::NAN, 0.1, 0.010, &STEEL, &STEEL).is_err());
     }
 }
+
+/// The contact physics of a scene at the rated operating point (43.9 kN m output, 112 kW at
+/// the paper's input speed), for side-by-side reports of the presets.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhysicsSummary {
+    /// Pin law kind (`impact`, `palmgren`, `line`).
+    pub pin_law: String,
+    /// Classical peak pin force `4 T_c / (zp rc')` at rated load, `T_c` half the output
+    /// torque [N].
+    pub peak_pin_force: f64,
+    /// Approach of the pin law at that force, at the classical peak-load pin [m].
+    pub pin_approach: f64,
+    /// Mesh law kind (`impact`, `palmgren`, `iso6336`).
+    pub mesh_law: String,
+    /// Rated tooth force per planet mesh `T_in / (planets r_bs)` [N].
+    pub mesh_force: f64,
+    /// Mean mesh stiffness [N/m]: ISO 6336 `c_gamma b`, or the secant stiffness of the IMPACT
+    /// law at the rated mesh force.
+    pub mesh_stiffness: f64,
+    /// Damping of the pin contacts, in words.
+    pub damping: String,
+}
+
+/// [`PhysicsSummary`] of `scene` (needs a first stage for the mesh entries; without one they
+/// are 0).
+///
+/// Errors from the laws (invalid parameters were rejected when the scene was built).
+pub fn physics_summary(scene: &crate::dynamics::Scene) -> Result<PhysicsSummary> {
+    use crate::contact::law::{ContactDamping, DampingSpec, MeshLaw, PinLaw};
+    use crate::dynamics::scene::{ContactLawSpec, PAPER_INPUT_SPEED, PAPER_POWER};
+    let kind = |s: &ContactLawSpec| {
+        match s {
+            ContactLawSpec::Impact { .. } => "impact",
+            ContactLawSpec::Palmgren { .. } => "palmgren",
+            ContactLawSpec::Line { .. } => "line",
+            ContactLawSpec::Iso6336 { .. } => "iso6336",
+        }
+        .to_string()
+    };
+    let ratio = scene.ratio();
+    let t_out = PAPER_POWER / (PAPER_INPUT_SPEED / ratio);
+    let c = scene.cycloid;
+    let zp = f64::from(c.pins);
+    let zc = zp - 1.0;
+    // Half the output torque per disc, the project's reference convention (the housing share
+    // (1 - 1/i) zc/zp of it would give 6 % less).
+    let tc = 0.5 * t_out;
+    let rc = c.eccentricity * zc;
+    let f_pin = 4.0 * tc / (zp * rc);
+    let g = CycloidGeometry::new(scene.disc_params(0))?;
+    let phi = g.k1().acos() / zc;
+    let pin_law = scene.contact.pin.pin_law(c.face_width)?;
+    let pin_approach = match &pin_law {
+        PinLaw::Impact(l) => (f_pin / l.stiffness).powf(1.0 / l.exponent),
+        PinLaw::Line { pin, disc, .. } => LineContactLaw::cycloid_contact(
+            &g,
+            phi,
+            c.pin_radius,
+            c.pin_circle_radius - c.pin_radius,
+            pin,
+            disc,
+        )?
+        .approach(f_pin)?,
+    };
+    let damping = match (&scene.contact.pin, &pin_law) {
+        (ContactLawSpec::Line { damping, .. }, _) => match damping {
+            DampingSpec::DampingRatio { ratio, frequency } => {
+                format!("stiffness-proportional, damping ratio {ratio} at {frequency} Hz")
+            }
+            DampingSpec::Restitution {
+                model,
+                restitution,
+                reference_speed,
+            } => {
+                let _ = ContactDamping::new(damping)?;
+                format!(
+                    "{} restitution {restitution} at {reference_speed} m/s",
+                    model.name()
+                )
+            }
+        },
+        (_, PinLaw::Impact(l)) => format!(
+            "IMPACT ramp to c_max = {} N s/m over {} m",
+            l.max_damping, l.damping_depth
+        ),
+        _ => String::new(),
+    };
+    let (mesh_force, mesh_stiffness) = match &scene.stage1 {
+        Some(s) => {
+            let f = t_out / ratio / (f64::from(s.planets) * s.sun_base_radius());
+            let k = match scene.contact.mesh.mesh_law(s)? {
+                MeshLaw::Iso(m) => m.wave.mean(),
+                MeshLaw::Impact(l) => {
+                    let x = (f / l.stiffness).powf(1.0 / l.exponent);
+                    f / x
+                }
+            };
+            (f, k)
+        }
+        None => (0.0, 0.0),
+    };
+    Ok(PhysicsSummary {
+        pin_law: kind(&scene.contact.pin),
+        peak_pin_force: f_pin,
+        pin_approach,
+        mesh_law: kind(&scene.contact.mesh),
+        mesh_force,
+        mesh_stiffness,
+        damping,
+    })
+}
+
+#[cfg(test)]
+mod summary_tests {
+    use super::*;
+    use crate::dynamics::Scene;
+
+    #[test]
+    fn presets_side_by_side() {
+        // Paper: IMPACT at the classical 35.35 kN: (F / 1.2611e10)^(2/3) = 198 um; mesh secant
+        // at 10.1 kN about 1.2e8 N/m. Physical: 25.9 um, ISO 5.546e8 N/m.
+        let p = physics_summary(&Scene::paper("rated").unwrap()).unwrap();
+        assert!((p.peak_pin_force / 35.35e3 - 1.0).abs() < 2e-3, "{p:?}");
+        assert!((p.pin_approach / 198e-6 - 1.0).abs() < 0.01, "{p:?}");
+        assert!((p.mesh_force / 10.1e3 - 1.0).abs() < 0.01, "{p:?}");
+        assert!(
+            p.mesh_stiffness > 1.1e8 && p.mesh_stiffness < 1.3e8,
+            "{p:?}"
+        );
+        let q = physics_summary(&Scene::physical("rated").unwrap()).unwrap();
+        assert_eq!(
+            (q.pin_law.as_str(), q.mesh_law.as_str()),
+            ("line", "iso6336")
+        );
+        assert!((q.pin_approach - 26.0e-6).abs() < 0.3e-6, "{q:?}");
+        assert!((q.mesh_stiffness / 5.546e8 - 1.0).abs() < 1e-3, "{q:?}");
+        assert!(q.damping.contains("0.05"), "{q:?}");
+    }
+}

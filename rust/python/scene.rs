@@ -111,6 +111,23 @@ impl CompiledScene {
         }
     }
 
+    /// The contact physics at the rated operating point, as JSON text: pin law, classical peak
+    /// pin force [N] and the law's approach there [m], mesh law, rated mesh force [N] and mean
+    /// mesh stiffness [N/m], damping in words (`analysis::pin_load_sharing::physics_summary`).
+    fn physics_summary(&self) -> PyResult<String> {
+        let p = crate::analysis::pin_load_sharing::physics_summary(&self.scene)?;
+        let v = serde_json::json!({
+            "pin_law": p.pin_law,
+            "peak_pin_force_N": p.peak_pin_force,
+            "pin_approach_m": p.pin_approach,
+            "mesh_law": p.mesh_law,
+            "mesh_force_N": p.mesh_force,
+            "mesh_stiffness_N_per_m": p.mesh_stiffness,
+            "damping": p.damping,
+        });
+        Ok(v.to_string())
+    }
+
     /// The scene as JSON text (pretty when `indent`).
     #[pyo3(signature = (indent = true))]
     fn to_json(&self, indent: bool) -> PyResult<String> {
