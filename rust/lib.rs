@@ -14,6 +14,8 @@
 //!
 //! Units are SI everywhere: m, kg, s, N, rad, Pa.
 
+#![warn(missing_docs)]
+
 pub mod analysis;
 pub mod bearing;
 pub mod contact;

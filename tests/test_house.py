@@ -208,3 +208,62 @@ def test_dopri5_stops_with_advice_on_a_stiff_scene() -> None:
     assert "Hz" in str(info.value)
     # The implicit method runs the same scene.
     assert simulate(s, 5e-3, channels=["motion"]).ok
+
+
+def test_work_and_memory_are_bounded() -> None:
+    # Issue 12 D3/D4/D14 (the simulate part): a sample count that overflowed returned an empty
+    # Result, dt = 1e-300 ran forever, a huge max_samples could abort on allocation.
+    s = Scene.paper("rated")
+    with pytest.raises(rvdyn.ParameterError, match="steps"):
+        simulate(s, 0.01, dt=1e-300)
+    for n in (2**64 - 1, 10**12):
+        with pytest.raises(rvdyn.ParameterError, match="max_samples"):
+            simulate(s, 0.01, max_samples=n, record_interval=5e-324)
+    with pytest.raises(rvdyn.ParameterError, match="steps"):
+        sweep([s], 0.01, "rk4", dt=1e-300)
+    # The largest accepted count still runs (the interval is what bounds the samples here).
+    r = simulate(s, 1e-3, max_samples=10**8, record_interval=1e-4, channels="motion")
+    assert r.t.shape == (11,)
+
+
+def test_damaged_result_files_raise_parameter_error(tmp_path: Path) -> None:
+    # Issue 12 D9 (the Result.load part): KeyError, JSONDecodeError, BadZipFile, EOFError...
+    good = simulate(Scene.paper("rated"), 1e-3, channels="motion").save(tmp_path / "good.npz")
+    cases = {
+        "missing.npz": None,
+        "text.npz": b"not a zip file",
+        "empty.npz": b"",
+        "truncated.npz": good.read_bytes()[:200],
+    }
+    for name, data in cases.items():
+        if data is not None:
+            (tmp_path / name).write_bytes(data)
+    np.savez(tmp_path / "nometa.npz", t=np.zeros(3))
+    np.savez(tmp_path / "badmeta.npz", __meta__=np.array("{not json"), t=np.zeros(3))
+    np.savez(tmp_path / "listmeta.npz", __meta__=np.array("[1, 2]"), t=np.zeros(3))
+    for name in [*cases, "nometa.npz", "badmeta.npz", "listmeta.npz"]:
+        with pytest.raises(rvdyn.ParameterError, match="cannot read result file"):
+            Result.load(tmp_path / name)
+    assert Result.load(good).t.shape == (11,)
+
+
+def test_numpy_integers_are_accepted_as_counts() -> None:
+    s = Scene.paper("rated")
+    o = Options(max_samples=np.int64(1000))
+    assert o.max_samples == 1000 and isinstance(o.max_samples, int)
+    out = sweep([s], 1e-3, threads=np.int64(1), max_samples=np.int32(100))
+    assert out[0].ok
+    with pytest.raises(rvdyn.ParameterError, match="threads"):
+        sweep([s], 1e-3, threads=1.5)  # type: ignore[arg-type]
+    with pytest.raises(rvdyn.ParameterError, match="threads"):
+        sweep([s], 1e-3, threads=0)
+
+
+def test_scene_values_may_be_numpy_numbers() -> None:
+    s = Scene.paper("rated").replace(**{"cranks": np.int64(3), "load.torque": np.float32(1e4),
+                                        "pin_errors.radius": np.zeros(24)})
+    assert s["cranks"] == 3 and s["load.torque"] == 1e4 and s["pin_errors.radius"] == [0.0] * 24
+    with pytest.raises(rvdyn.SceneError, match="not a number"):
+        Scene.paper().replace(**{"load.torque": object()})
+    with pytest.raises(rvdyn.SceneError, match="NaN"):
+        Scene.paper().replace(**{"load.torque": np.float64("nan")})

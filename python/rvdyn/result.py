@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import zipfile
 from pathlib import Path
 from typing import Any, Generic, Iterable, TypeVar, overload
 
@@ -285,10 +286,23 @@ class Result:
 
     @classmethod
     def load(cls, path: str | Path) -> Result:
-        """Read a file written by :meth:`save` (never unpickles: ``allow_pickle=False``)."""
-        with np.load(Path(path), allow_pickle=False) as f:
-            meta = json.loads(str(f["__meta__"]))
-            arrays = {k: f[k] for k in f.files if k != "__meta__"}
+        """Read a file written by :meth:`save` (never unpickles: ``allow_pickle=False``).
+
+        A file that is missing, damaged or not written by :meth:`save` raises
+        :class:`ParameterError` naming the file, with the original error chained.
+        """
+        p = Path(path)
+        try:
+            # The file is opened here so that it is closed also when numpy fails to read it.
+            with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as f:
+                if "__meta__" not in f.files:
+                    raise ValueError("no __meta__ entry: not a file written by Result.save")
+                meta = json.loads(str(f["__meta__"]))
+                if not isinstance(meta, dict):
+                    raise ValueError("__meta__ is not a JSON object")
+                arrays = {k: f[k] for k in f.files if k != "__meta__"}
+        except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as exc:
+            raise ParameterError(f"cannot read result file {str(p)!r}: {exc}") from exc
         return cls(arrays, meta.get("stats", {}), meta.get("scene"), meta.get("options"))
 
     # -------------------------------------------------------------------- plots

@@ -21,9 +21,16 @@ __all__ = ["Scene"]
 
 
 
+def _plain(value: Any) -> Any:
+    """numpy scalars and arrays as Python numbers and lists (for JSON)."""
+    if hasattr(value, "tolist") and callable(value.tolist):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not a number, string, list or dict")
+
+
 def _json_value(path: str, value: Any) -> str:
     try:
-        return json.dumps(value, allow_nan=False)
+        return json.dumps(value, allow_nan=False, default=_plain)
     except (TypeError, ValueError) as exc:
         raise SceneError(
             f"scene field {path!r}: values must be numbers, strings, lists or dicts without NaN/inf ({exc})"

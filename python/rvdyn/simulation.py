@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import operator
 import sys
 from typing import Any, Iterable, Mapping, Sequence
 
@@ -138,8 +139,15 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
         "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated})
     t = _t_end(t_end)
     used = opts.resolved(t)
-    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
-        raise ParameterError(f"threads must be a whole number >= 1 (None = one per core), got {threads!r}")
+    if threads is not None:
+        try:
+            if isinstance(threads, bool):
+                raise TypeError
+            threads = operator.index(threads)  # Python and numpy integers
+        except TypeError:
+            raise ParameterError(f"threads must be a whole number >= 1 (None = one per core), got {threads!r}") from None
+        if threads < 1:
+            raise ParameterError(f"threads must be a whole number >= 1 (None = one per core), got {threads!r}")
     raw = _core.sweep([s._compiled for s in scene_list], t, opts, threads=threads)
     out: list[Result] = []
     for scene, point, item in zip(scene_list, points, raw):

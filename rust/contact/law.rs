@@ -22,19 +22,29 @@ pub enum DampingSpec {
     /// the coefficient of restitution `restitution` by `model` ("exact", "hunt-crossley",
     /// "lankarani-nikravesh", "flores") at the reference speed `reference_speed` [m/s].
     Restitution {
+        /// Closed form of the hysteresis factor.
         model: HysteresisModel,
+        /// Coefficient of restitution [-], in (0, 1].
         restitution: f64,
+        /// Impact speed at which the restitution holds [m/s].
         reference_speed: f64,
     },
     /// Stiffness-proportional: `F = F_el + beta k_t rate`, `beta = 2 ratio / (2 pi frequency)`:
     /// the damping ratio `ratio` [-] of a linearised mode at `frequency` [Hz].
-    DampingRatio { ratio: f64, frequency: f64 },
+    DampingRatio {
+        /// Damping ratio [-], in [0, 1).
+        ratio: f64,
+        /// Reference frequency [Hz].
+        frequency: f64,
+    },
 }
 
 /// A damping law built from a [`DampingSpec`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ContactDamping {
+    /// Restitution-based (Hunt-Crossley family).
     Hysteresis(HysteresisDamping),
+    /// Stiffness-proportional.
     Proportional(StiffnessProportionalDamping),
 }
 
@@ -116,8 +126,11 @@ pub enum PinLaw {
     Impact(ImpactLaw),
     /// Line contact from the local geometry (Johnson; `contact::line_contact`) with damping.
     Line {
+        /// Pin material.
         pin: Material,
+        /// Disc material.
         disc: Material,
+        /// Damping of the contact.
         damping: ContactDamping,
     },
 }

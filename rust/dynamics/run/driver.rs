@@ -9,6 +9,11 @@ use crate::error::{Result, RvdynError};
 use crate::solve::{Integrator, Method, Settings, State};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
+/// Most samples a run may keep (each sample holds up to a few hundred values of 8 bytes).
+pub const MAX_SAMPLES: usize = 100_000_000;
+/// Most steps a fixed-step run may take.
+pub const MAX_STEPS: f64 = 1e10;
+
 /// Options of one run (SI).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimOptions {
@@ -86,7 +91,24 @@ impl SimOptions {
                 "dt must be > 0 s and <= t_end, got {dt}"
             )));
         }
-        self.validate_settings()
+        self.validate_settings()?;
+        // A bound on the work: a fixed-step run of more than MAX_STEPS steps is a mistake
+        // (dt = 1e-300 would never end), not a request.
+        if !self.method.0.adaptive {
+            let dt = self.dt.unwrap_or_else(|| self.method.default_dt());
+            let steps = self.t_end / dt;
+            if steps > MAX_STEPS {
+                return Err(RvdynError::Parameter(format!(
+                    "dt = {dt:.3e} s over t_end = {:.3e} s would take {steps:.2e} steps, more \
+                     than {MAX_STEPS:.0e}: raise dt (the default of {} is {:.0e} s) or shorten \
+                     the run",
+                    self.t_end,
+                    self.method.name(),
+                    self.method.default_dt()
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Check every option but the end time (what a reusable options object can check).
@@ -114,8 +136,11 @@ impl SimOptions {
         {
             return bad(format!("record_interval must be > 0 s, got {r}"));
         }
-        if self.max_samples < 2 {
-            return bad("max_samples must be at least 2".into());
+        if !(2..=MAX_SAMPLES).contains(&self.max_samples) {
+            return bad(format!(
+                "max_samples must be in 2..={MAX_SAMPLES:.0e} (memory: 8 bytes per value), got {}",
+                self.max_samples
+            ));
         }
         Ok(())
     }

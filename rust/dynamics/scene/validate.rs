@@ -1,0 +1,236 @@
+//! The rules a scene must follow as a whole (docs/scene.md lists them per field); each error
+//! names the field and how to fix it.
+
+use super::*;
+
+impl Scene {
+    /// Check the scene as a whole; errors say which field is wrong and how to fix it.
+    pub fn validate(&self) -> Result<()> {
+        let err = |m: String| Err(RvdynError::Scene(m));
+        if self.discs.is_empty() || self.discs.len() > 2 {
+            return err(format!(
+                "a scene needs 1 or 2 discs, got {}",
+                self.discs.len()
+            ));
+        }
+        for (k, d) in self.discs.iter().enumerate() {
+            for (n, v) in [
+                ("phase", Some(d.phase)),
+                ("d_rp", d.d_rp),
+                ("d_rrp", d.d_rrp),
+                ("d_delta", d.d_delta),
+            ] {
+                if let Some(v) = v
+                    && !v.is_finite()
+                {
+                    return err(format!("discs[{k}].{n} must be finite, got {v}"));
+                }
+            }
+            crate::geometry::CycloidGeometry::check(self.disc_params(k))?;
+        }
+        if self.cranks < 1 {
+            return err("cranks must be at least 1".into());
+        }
+        if let Some(s) = &self.stage1 {
+            s.validate()?;
+            if s.planets != self.cranks {
+                return err(format!(
+                    "stage1.planets = {} must equal cranks = {} (each planet sits on a crank)",
+                    s.planets, self.cranks
+                ));
+            }
+        }
+        let zp = self.cycloid.pins as usize;
+        if !self.pin_errors.position.is_empty() && self.pin_errors.position.len() != zp {
+            return err(format!(
+                "pin_errors.position must have one (dx, dy) per pin ({zp}), got {}",
+                self.pin_errors.position.len()
+            ));
+        }
+        if !self.pin_errors.radius.is_empty() && self.pin_errors.radius.len() != zp {
+            return err(format!(
+                "pin_errors.radius must have one value per pin ({zp}), got {}",
+                self.pin_errors.radius.len()
+            ));
+        }
+        if self
+            .pin_errors
+            .position
+            .iter()
+            .flatten()
+            .chain(&self.pin_errors.radius)
+            .any(|v| !v.is_finite())
+        {
+            return err("pin_errors must be finite".into());
+        }
+        if !(self.density.is_finite() && self.density > 0.0) {
+            return err(format!("density must be > 0 kg/m^3, got {}", self.density));
+        }
+        let i = &self.inertias;
+        for (n, mp) in [
+            ("sun", i.sun),
+            ("crank", i.crank),
+            ("disc", i.disc),
+            ("carrier", i.carrier),
+        ] {
+            if let Some(mp) = mp
+                && !(mp.mass.is_finite()
+                    && mp.mass > 0.0
+                    && mp.inertia.is_finite()
+                    && mp.inertia > 0.0)
+            {
+                return err(format!(
+                    "inertias.{n} needs mass > 0 kg and inertia > 0 kg m^2, got {mp:?}"
+                ));
+            }
+        }
+        if !(i.load_inertia.is_finite() && i.load_inertia >= 0.0) {
+            return err(format!(
+                "inertias.load_inertia must be >= 0 kg m^2, got {}",
+                i.load_inertia
+            ));
+        }
+        if let Joints::Compliant {
+            eccentric_bearing,
+            crank_bearing,
+        } = self.joints
+        {
+            for (n, b) in [
+                ("eccentric_bearing", Some(eccentric_bearing)),
+                ("crank_bearing", crank_bearing),
+            ]
+            .into_iter()
+            .filter_map(|(n, b)| b.map(|b| (n, b)))
+            {
+                if !(b.clearance.is_finite() && b.clearance >= 0.0) {
+                    return err(format!(
+                        "joints.{n}.clearance must be >= 0 m (no preload), got {}",
+                        b.clearance
+                    ));
+                }
+                if let Some(r) = &b.rollers {
+                    r.check(&format!("joints.{n}"))?;
+                    if !(b.stiffness.is_finite()
+                        && b.stiffness >= 0.0
+                        && b.damping.is_finite()
+                        && b.damping >= 0.0)
+                    {
+                        return err(format!(
+                            "joints.{n} has rollers: stiffness and damping (a linear \
+                             spring-damper in parallel, 0 for none) must be >= 0, got {} N/m \
+                             and {} N s/m",
+                            b.stiffness, b.damping
+                        ));
+                    }
+                } else if !(b.stiffness.is_finite()
+                    && b.stiffness > 0.0
+                    && b.damping.is_finite()
+                    && b.damping >= 0.0)
+                {
+                    return err(format!(
+                        "joints.{n} needs stiffness > 0 N/m, damping >= 0 N s/m, clearance >= 0 m; got {b:?}"
+                    ));
+                }
+            }
+        }
+        self.friction.check()?;
+        self.errors.check(
+            self.cranks as usize,
+            self.discs.len(),
+            self.cycloid.eccentricity,
+        )?;
+        if self.errors.any() && matches!(self.joints, Joints::Rigid) {
+            return err(
+                "errors (crank, hole and seat errors) need compliant joints: with ideal joints \
+                 they over-constrain the discs; set joints.kind = \"compliant\""
+                    .into(),
+            );
+        }
+        self.contact.pin.pin_law(self.cycloid.face_width)?;
+        if matches!(self.contact.pin, ContactLawSpec::Line { .. }) {
+            // The line law needs 1/r_pin + kappa_profile > 0 along the whole profile (a concave
+            // root flatter than the pin); check the most concave point, the root, on a fine
+            // sample of one lobe of every disc, with the largest pin.
+            let r_pin = self.cycloid.pin_radius
+                + self.pin_errors.radius.iter().cloned().fold(0.0, f64::max);
+            for k in 0..self.discs.len() {
+                let g = crate::geometry::CycloidGeometry::new(self.disc_params(k))?;
+                let lobe = std::f64::consts::TAU / f64::from(g.lobes());
+                for i in 0..=256 {
+                    let phi = lobe * (f64::from(i) / 256.0 - 0.5);
+                    let kp = crate::contact::line_contact::pin_disc_profile_curvature(
+                        g.centre_curve_curvature(phi),
+                        g.generating_pin_radius(),
+                    )?;
+                    if 1.0 / r_pin + kp <= 0.0 {
+                        return err(format!(
+                            "contact.pin = \"line\": disc {k}'s profile is more concave ({:.4e} m \
+                             radius at curve parameter {phi:.4} rad) than a pin of radius \
+                             {r_pin} m is convex: the pin would sit in a conformal or nested \
+                             seat, not a Hertz line contact",
+                            1.0 / kp
+                        ));
+                    }
+                }
+            }
+        }
+        if let Some(s) = &self.stage1 {
+            self.contact.mesh.mesh_law(s)?;
+        }
+        match self.drive {
+            Drive::Speed {
+                speed,
+                start,
+                ramp_time,
+            } => {
+                if !speed.is_finite() {
+                    return err(format!("drive.speed must be finite rad/s, got {speed}"));
+                }
+                if start == StartKind::Ramp && !(ramp_time.is_finite() && ramp_time > 0.0) {
+                    return err(format!(
+                        "drive.ramp_time must be > 0 s for a ramp start, got {ramp_time}"
+                    ));
+                }
+            }
+            Drive::Torque { torque, ramp_time } => {
+                if !(torque.is_finite() && ramp_time.is_finite() && ramp_time >= 0.0) {
+                    return err(format!(
+                        "drive.torque must be finite and ramp_time >= 0, got {torque}, {ramp_time}"
+                    ));
+                }
+                if self.initial == Initial::Steady {
+                    return err("initial = \"steady\" needs a speed drive (the steady speed is undefined for a torque drive)".into());
+                }
+            }
+        }
+        match &self.load {
+            Load::Idle => {}
+            Load::Constant { torque } => {
+                if !torque.is_finite() {
+                    return err(format!("load.torque must be finite N m, got {torque}"));
+                }
+            }
+            Load::Step {
+                before,
+                after,
+                time,
+            } => {
+                if !(before.is_finite() && after.is_finite() && time.is_finite()) {
+                    return err("load step values must be finite".into());
+                }
+            }
+            Load::Table { points } => {
+                if points.is_empty() {
+                    return err("load.points needs at least one (t, torque) pair".into());
+                }
+                if points.iter().flatten().any(|v| !v.is_finite()) {
+                    return err("load.points must be finite".into());
+                }
+                if points.windows(2).any(|w| w[1][0] <= w[0][0]) {
+                    return err("load.points times must increase strictly".into());
+                }
+            }
+        }
+        Ok(())
+    }
+}
