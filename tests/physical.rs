@@ -442,3 +442,25 @@ fn equal_hole_error_moves_the_disc_by_that_error() {
     ];
     assert!(other[0].hypot(other[1]) < 0.1e-6, "{other:?}");
 }
+
+#[test]
+fn bearing_friction_closes_the_energy_balance_and_costs_efficiency() {
+    // Palmgren torques on the roller bearings (f0 3, f1 3e-4, 68 cSt): positive friction power,
+    // the energy balance still closes (1e-6 of the input work), efficiency below 1.
+    let mut s = with_friction(0.0, 0.0);
+    s.friction.bearing = Some(rvdyn::dynamics::scene::BearingFriction {
+        f0: 3.0,
+        f1: 3e-4,
+        viscosity: 68e-6,
+    });
+    let r = run(&s, 0.03, 1e-7, 1e-10);
+    let n = r.samples;
+    let p = data(&r, "bearing_friction_power");
+    let mean = p[n / 2..].iter().sum::<f64>() / (n - n / 2) as f64;
+    let (wi, wo) = (data(&r, "input_work"), data(&r, "output_work"));
+    let eta = (wo[n - 1] - wo[n / 2]) / (wi[n - 1] - wi[n / 2]);
+    eprintln!("bearing friction power {mean:.0} W, efficiency {eta:.4}");
+    assert!(mean > 0.0 && eta < 0.999, "{mean} {eta}");
+    let res = data(&r, "energy_residual")[n - 1];
+    assert!(res.abs() < 1e-6 * wi[n - 1].abs(), "{res}");
+}
