@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from . import _core
 from .errors import ParameterError, RvdynError
+from .plotting import _real, _whole, pin_indices
 
 __all__ = ["Result", "CHANNELS", "CHANNEL_SPECS"]
 
@@ -141,7 +142,14 @@ class Result:
     # ----------------------------------------------------------------- analysis
     def _steady_start(self, t_start: float | None) -> float:
         t = self.t
-        return float(t[-1] * 0.2 if t_start is None else t_start)
+        t0 = float(t[-1] * 0.2) if t_start is None else _real("t_start [s]", t_start)
+        if not (t[0] <= t0 < t[-1]):
+            raise ParameterError(f"t_start = {t0:.6g} s must lie inside the run [{t[0]:.6g}, {t[-1]:.6g}) s")
+        return t0
+
+    def _disc(self, disc: Any) -> int:
+        """A disc index checked against the recorded discs."""
+        return _whole("disc", disc, 0, int(self.disc_center.shape[1]) - 1)
 
     def steady_window(self, t_start: float | None = None) -> tuple[float, float]:
         """The largest window ``[t0, t_end]`` with ``t0 >= t_start`` spanning whole crank
@@ -150,8 +158,6 @@ class Result:
         t = self.t
         rel = self.crank_angle[:, 0] - self.carrier_angle
         t0 = self._steady_start(t_start)
-        if not (t[0] <= t0 < t[-1]):
-            raise ParameterError(f"t_start = {t0} s must lie inside the run [0, {t[-1]}) s")
         i0 = int(np.searchsorted(t, t0))
         span = abs(rel[-1] - rel[i0])
         turns = math.floor(span / (2 * math.pi))
@@ -203,8 +209,13 @@ class Result:
 
     def largest_moment_pin(self, time: float, disc: int = 0) -> int:
         """The paper's number (1-based) of the pin with the largest |moment| on ``disc`` at the
-        sample nearest ``time`` [s]."""
-        i = int(np.argmin(np.abs(self.t - time)))
+        sample nearest ``time`` [s] (inside the run)."""
+        t = self.t
+        time = _real("time [s]", time)
+        if not (t[0] <= time <= t[-1]):
+            raise ParameterError(f"time = {time:.6g} s must lie inside the run [{t[0]:.6g}, {t[-1]:.6g}] s")
+        disc = self._disc(disc)
+        i = int(np.argmin(np.abs(t - time)))
         return int(np.argmax(np.abs(self.pin_moment[i, disc]))) + 1
 
     def energy_balance(self) -> dict[str, float]:
@@ -321,6 +332,7 @@ class Result:
         """Disc centre x and y vs time [mm] and its path, as the paper's Fig. 7."""
         import matplotlib.pyplot as plt
 
+        disc = self._disc(disc)
         if axes is None:
             _, axes = plt.subplots(1, 2, figsize=(11, 4))
         c = self.disc_center[:, disc] * 1e3
@@ -336,11 +348,16 @@ class Result:
                          window: tuple[float, float] | None = None, ax: Any = None) -> Any:
         """Moment of each pin's force about the disc centre [N m] vs time, for the paper's pin
         numbers ``pins`` (1-based), as the paper's Figs. 8-14, in ``window`` [s]."""
+        pins = list(pins)
+        index = pin_indices(pins, int(self.pin_moment.shape[2]))
+        disc = self._disc(disc)
+        if window is not None:
+            window = (_real("window start [s]", window[0]), _real("window end [s]", window[1]))
         ax = _axes(ax)
         t = self.t
         sel = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
-        for p in pins:
-            ax.plot(t[sel], self.pin_moment[sel, disc, p - 1], lw=0.8, label=f"pin {p}")
+        for p, j in zip(pins, index):
+            ax.plot(t[sel], self.pin_moment[sel, disc, j], lw=0.8, label=f"pin {p}")
         ax.set(xlabel="time [s]", ylabel=f"moment about disc {disc} centre [N m]")
         ax.legend(ncol=4, fontsize="small")
         return ax

@@ -31,6 +31,8 @@ def _plain(value: Any) -> Any:
 def _json_value(path: str, value: Any) -> str:
     try:
         return json.dumps(value, allow_nan=False, default=_plain)
+    except RecursionError as exc:
+        raise SceneError(f"scene field {path!r}: the value is nested too deeply to be a scene value") from exc
     except (TypeError, ValueError) as exc:
         raise SceneError(
             f"scene field {path!r}: values must be numbers, strings, lists or dicts without NaN/inf ({exc})"

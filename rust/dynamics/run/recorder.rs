@@ -502,6 +502,34 @@ impl Recorder {
         }
     }
 
+    /// Values recorded per sample over all series.
+    pub fn values_per_sample(&self) -> usize {
+        self.rec
+            .series
+            .values()
+            .map(|s| s.sample_shape.iter().product::<usize>())
+            .sum()
+    }
+
+    /// Reserve room for `samples` samples in every series without the aborting allocation
+    /// path: `RvdynError::Memory` if the memory cannot be had.
+    pub fn reserve(&mut self, samples: usize) -> Result<()> {
+        for (name, s) in self.rec.series.iter_mut() {
+            let per: usize = s.sample_shape.iter().product();
+            let n = samples.saturating_mul(per);
+            let extra = n.saturating_sub(s.data.len());
+            if s.data.try_reserve_exact(extra).is_err() {
+                return Err(RvdynError::Memory(format!(
+                    "cannot allocate channel {name}: {samples} samples of {per} values \
+                     ({:.3e} bytes); record fewer samples (max_samples, record_interval) or \
+                     fewer channels",
+                    n as f64 * 8.0
+                )));
+            }
+        }
+        Ok(())
+    }
+
     fn push(&mut self, name: &'static str, values: &[f64]) {
         if let Some(s) = self.rec.series.get_mut(name) {
             s.data.extend_from_slice(values);
