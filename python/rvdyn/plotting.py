@@ -25,7 +25,7 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["plot_geometry", "plot_stiffness", "new_figure", "save_figure", "pin_indices"]
 
 #: The paper's stiffness maxima (section 3.2), printed as N/mm^2, read as N/mm^1.5
-#: (design.md erratum 4), "near 5 mm" contact width.
+#: (docs/model.md#erratum-4), "near 5 mm" contact width.
 PAPER_STIFFNESS_MAXIMA = {"convex-convex": 3.988e5, "convex-concave": 5.093e5}
 PAPER_STIFFNESS_WIDTH = 5e-3
 _PER_MM15 = 1000.0**1.5

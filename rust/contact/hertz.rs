@@ -3,7 +3,7 @@
 //! Convention: a radius is positive for a convex surface and negative for a concave one (a
 //! pin inside a concave cycloid root). Sources: Johnson, Contact Mechanics (1985), ch. 4-5;
 //! Roark's Formulas for Stress and Strain (cylinder on cylinder); Harris, Rolling Bearing
-//! Analysis (Palmgren); see `notes/physics.md` section 3.
+//! Analysis (Palmgren); see docs/model.md#contact-laws.
 
 use crate::error::{Result, RvdynError, num, require_non_negative, require_positive};
 use serde::{Deserialize, Serialize};
@@ -65,7 +65,7 @@ impl Material {
 /// Effective (contact) modulus `E*` [Pa] of two materials.
 ///
 /// Returns `E*` with `1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2`. The paper's eq. 8 subtracts the
-/// two terms (design.md erratum 1), which is zero for equal materials; the sum is Hertz's.
+/// two terms (docs/model.md#erratum-1), which is zero for equal materials; the sum is Hertz's.
 /// Two paper steels give `E* = 2.17e11 / (2 * 0.91) = 1.1923e11 Pa`.
 pub fn effective_modulus(m1: &Material, m2: &Material) -> f64 {
     1.0 / (m1.compliance() + m2.compliance())
@@ -286,7 +286,7 @@ mod tests {
 
     #[test]
     fn default_pin_contact_numbers() {
-        // notes/physics.md section 3: F = 35 kN, L = 40 mm, R_pin 10 mm, R_disc 94 mm.
+        // docs/model.md#contact-laws: F = 35 kN, L = 40 mm, R_pin 10 mm, R_disc 94 mm.
         // P = 875e3 N/m, R = 9.0385e-3 m, E* = 1.19231e11 Pa:
         // a = sqrt(4 * 875e3 * 9.0385e-3 / (pi * 1.19231e11)) = sqrt(8.4453e-8) = 2.9061e-4 m.
         let c = hertz_line_contact(35e3, 0.040, 0.010, 0.094, &STEEL, &STEEL).unwrap();

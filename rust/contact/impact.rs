@@ -3,7 +3,7 @@
 //! For penetration `x > 0`: `F = k x^e + STEP(x, 0, 0, d, cmax) * xdot`, and `F >= 0`.
 //! The damping coefficient is 0 at first touch and `cmax` from the depth `d` on, so the force
 //! is continuous at contact (a plain `c * xdot` would jump at impact). Sources: MSC ADAMS
-//! solver manual, IMPACT function; see `notes/physics.md` section 3.1.
+//! solver manual, IMPACT function; see docs/model.md#contact-laws.
 
 use crate::error::{Result, RvdynError, num, require_positive};
 use serde::{Deserialize, Serialize};
@@ -100,8 +100,8 @@ impl ImpactLaw {
     }
 
     /// The paper's pin-cycloid law (section 3.1): k = 3.988e5 N/mm^1.5 (printed as "N/mm^2",
-    /// design.md erratum 4) = 3.988e5 * 1000^1.5 N/m^1.5, e = 1.5, cmax = 100 N s/mm = 1e5 N s/m,
-    /// d = 0.01 mm = 1e-5 m.
+    /// docs/model.md#erratum-4) = 3.988e5 * 1000^1.5 N/m^1.5, e = 1.5,
+    /// cmax = 100 N s/mm = 1e5 N s/m, d = 0.01 mm = 1e-5 m.
     pub fn paper() -> Self {
         Self {
             stiffness: 3.988e5 * 1000f64.powf(1.5),

@@ -2,7 +2,7 @@
 //!
 //! With the paper's symbols, evaluated in the paper's units (N, mm):
 //!
-//! - eq. 8 corrected (design.md erratum 1): `C_E = 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2`;
+//! - eq. 8 corrected (docs/model.md#erratum-1): `C_E = 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2`;
 //! - eq. 7: `R = R1 R2 / (R1 + R2)` convex-convex, `R1 R2 / (R2 - R1)` convex-concave;
 //! - eq. 6: `k' = (4/3) E* sqrt(R)` [N/mm^1.5] (Hertz point-contact coefficient);
 //! - eq. 10: `F = k' x^e`, `x` the IMPACT penetration depth parameter (paper 0.01 mm);

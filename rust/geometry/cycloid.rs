@@ -97,8 +97,9 @@ pub struct CycloidParams {
 }
 
 impl CycloidParams {
-    /// The default disc of the paper's scene (design.md section 7): 24 pins and e = 4.5 mm are
-    /// given; rp = 150 mm, rrp = 10 mm and the 40 mm face width are assumed; no modification.
+    /// The default disc of the paper's scene (docs/model.md#default-scene): 24 pins and
+    /// e = 4.5 mm are given; rp = 150 mm, rrp = 10 mm and the 40 mm face width are assumed;
+    /// no modification.
     pub fn paper() -> Self {
         Self {
             pins: 24,
@@ -473,7 +474,7 @@ pub(crate) mod tests {
 
     #[test]
     fn min_convex_radius_matches_the_notes() {
-        // notes/physics.md 1.4: rho_min(convex) = 20.75 mm for the default geometry.
+        // docs/model.md#cycloid-geometry: rho_min(convex) = 20.75 mm for the default geometry.
         let g = CycloidGeometry::new(paper_params()).unwrap();
         assert!(
             (g.min_convex_radius() - 20.75e-3).abs() < 0.01e-3,
@@ -494,7 +495,7 @@ pub(crate) mod tests {
 
     #[test]
     fn root_is_concave_with_the_notes_radius() {
-        // notes/physics.md 1.4: profile radius at the root is -10.72 mm.
+        // docs/model.md#cycloid-geometry: profile radius at the root is -10.72 mm.
         let g = CycloidGeometry::new(paper_params()).unwrap();
         assert!((g.curvature_radius(0.0) + 10.72e-3).abs() < 0.005e-3);
     }

@@ -1,7 +1,7 @@
 //! Mass properties of the reducer bodies from their geometry (steel by default).
 //!
 //! The paper gives no masses; these simple solids are the default scene's assumptions
-//! (design.md section 7), each stated where it is built.
+//! (docs/model.md#default-scene), each stated where it is built.
 
 use crate::error::{Result, RvdynError, num, require_positive};
 use crate::geometry::cycloid::CycloidGeometry;
@@ -57,8 +57,8 @@ pub struct DiscHoles {
 }
 
 impl DiscHoles {
-    /// The default disc (design.md section 7): 40 mm bore radius, 3 crank holes r = 25 mm and
-    /// 3 pillar holes r = 20 mm on a 90 mm circle.
+    /// The default disc (docs/model.md#default-scene): 40 mm bore radius, 3 crank holes
+    /// r = 25 mm and 3 pillar holes r = 20 mm on a 90 mm circle.
     pub fn paper() -> Self {
         Self {
             bore_radius: 0.040,
@@ -216,7 +216,7 @@ mod tests {
     fn default_disc_matches_the_design_estimate() {
         let g = CycloidGeometry::new(paper_params()).unwrap();
         let mp = disc_mass_properties(&g, &DiscHoles::paper(), STEEL_DENSITY).unwrap();
-        // design.md section 7: about 14.7 kg and 0.163 kg m^2.
+        // docs/model.md#default-scene: about 14.7 kg and 0.163 kg m^2.
         assert!((mp.mass - 14.7).abs() < 0.15, "{mp:?}");
         assert!((mp.inertia - 0.163).abs() < 0.004, "{mp:?}");
     }

@@ -1,5 +1,5 @@
 //! Lossless operating point: speeds and torques from power, input speed and ratio
-//! (paper section 4.1, design.md erratum 3).
+//! (paper section 4.1, docs/model.md#erratum-3).
 
 use crate::error::{Result, RvdynError, num, require_finite};
 
@@ -7,7 +7,7 @@ use crate::error::{Result, RvdynError, num, require_finite};
 ///
 /// Inconsistent with the paper's own data: at the output speed 8328/57 = 146.105 deg/s
 /// (2.550 rad/s) it carries only 4024.9 * 2.550 = 10.26 kW, not the stated 112 kW; the
-/// lossless output torque at 112 kW is 57 x 770.6 = 43.92 kN m (design.md erratum 3). Kept as
+/// lossless output torque at 112 kW is 57 x 770.6 = 43.92 kN m (docs/model.md#erratum-3). Kept as
 /// the paper's "full load" case, labelled as such.
 pub const PAPER_PRINTED_OUTPUT_TORQUE: f64 = 4024.9;
 

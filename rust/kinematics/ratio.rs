@@ -3,7 +3,8 @@
 //! Sun (input) -> planets on crankshafts whose axes are fixed in the carrier -> eccentrics ->
 //! cycloid discs meshing with fixed pins -> carrier (output). With carrier speed `w_c`, crank
 //! speed relative to the carrier `phi'` and the disc lobes `zc = pins - 1`:
-//! - the discs mesh with the fixed pins when `phi' = -pins w_c` (design.md section 5);
+//! - the discs mesh with the fixed pins when `phi' = -pins w_c`
+//!   (docs/model.md#coordinates-and-degrees-of-freedom);
 //! - the sun/planet mesh rolls: `r_s (w_s - w_c) = -r_p phi'`, so
 //!   `w_s = w_c (1 + pins z_planet / z_sun)` and `i = w_s / w_c = 1 + (z_planet/z_sun) pins`.
 

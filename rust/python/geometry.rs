@@ -12,8 +12,8 @@ use crate::geometry::{CycloidGeometry, InvoluteStage, PinGap};
 use pyo3::prelude::*;
 use pyo3::types::{PyTuple, PyType};
 
-/// The default disc of the paper's scene (design.md section 7): 24 pins and e = 4.5 mm are
-/// given; rp = 150 mm, rrp = 10 mm and the 40 mm face width are assumed.
+/// The default disc of the paper's scene (docs/model.md#default-scene): 24 pins and
+/// e = 4.5 mm are given; rp = 150 mm, rrp = 10 mm and the 40 mm face width are assumed.
 fn paper_cycloid() -> CycloidParams {
     CycloidParams::paper()
 }
@@ -166,7 +166,7 @@ impl PyCycloidGeometry {
     }
 
     /// The paper's default disc: zp = 24, e = 4.5 mm (given); rp = 150 mm, rrp = 10 mm, face
-    /// width 40 mm (assumed, design.md section 7); no modification.
+    /// width 40 mm (assumed, docs/model.md#default-scene); no modification.
     #[classmethod]
     fn paper(_cls: &Bound<'_, PyType>) -> PyResult<Self> {
         Ok(Self {
@@ -354,7 +354,8 @@ impl PyCycloidGeometry {
 
     /// Classical quasi-static pin forces [N], shape (zp,), of the unmodified disc carrying
     /// `disc_torque` [N m] about its centre with its centre at crank angle `crank_angle` [rad]
-    /// (notes/physics.md 2.1: F_j = T l_j / sum l^2 on the loaded half).
+    /// (docs/model.md#lever-arms-and-the-classical-load-sharing: F_j = T l_j / sum l^2 on the
+    /// loaded half).
     fn classical_pin_forces<'py>(
         &self,
         py: Python<'py>,
@@ -526,7 +527,7 @@ impl PyInvoluteStage {
     }
 
     /// The paper's first stage: z_sun 18, z_planet 42, 3 planets (given); module 3 mm,
-    /// pressure angle 20 deg, face width 30 mm (assumed, design.md section 7); no backlash.
+    /// pressure angle 20 deg, face width 30 mm (assumed, docs/model.md#default-scene); no backlash.
     #[classmethod]
     fn paper(_cls: &Bound<'_, PyType>) -> PyResult<Self> {
         Ok(Self {
