@@ -3,6 +3,7 @@
 
 pub mod hertz;
 pub mod impact;
+pub mod pin_tangent;
 pub mod stiffness;
 
 pub use hertz::{LineContact, Material, effective_modulus, hertz_line_contact};
