@@ -1,5 +1,6 @@
 //! Analysis: quasi-static references for the dynamic results.
 
 pub mod load_sharing;
+pub mod ltca;
 
 pub use load_sharing::{classical_levers, classical_pin_forces};

@@ -169,10 +169,7 @@ pub(crate) fn gap_jet_cs(
         [c * v[0] - s * v[1], s * v[0] + c * v[1]]
     };
     let n = rot(normal);
-    let arm = rot([
-        cp[0] - r_gen * normal[0],
-        cp[1] - r_gen * normal[1],
-    ]);
+    let arm = rot([cp[0] - r_gen * normal[0], cp[1] - r_gen * normal[1]]);
     let t = [-n[1], n[0]];
     let cross = |a: [f64; 2], b: [f64; 2]| a[0] * b[1] - a[1] * b[0];
     let grad = [-n[0], -n[1], -cross(r, n)];
@@ -288,7 +285,10 @@ mod tests {
         }
         eprintln!("gradient vs FD {worst_g:e}, Hessian vs FD {worst_h:e}");
         assert!(worst_g < 1e-6, "gradient vs FD: {worst_g:e}");
-        assert!(worst_h < 1e-6, "Hessian vs FD: {worst_h:e} of the largest entry");
+        assert!(
+            worst_h < 1e-6,
+            "Hessian vs FD: {worst_h:e} of the largest entry"
+        );
     }
 
     #[test]
@@ -298,7 +298,10 @@ mod tests {
         // normal are those of CycloidGeometry::gap.
         let g = CycloidGeometry::new(CycloidParams::paper()).unwrap();
         for psi in [0.0, 0.123, 1.7, -2.9] {
-            let (c, a) = ([4.5e-3 * f64::cos(psi), 4.5e-3 * f64::sin(psi)], -psi / 23.0);
+            let (c, a) = (
+                [4.5e-3 * f64::cos(psi), 4.5e-3 * f64::sin(psi)],
+                -psi / 23.0,
+            );
             let levers = crate::analysis::classical_levers(&g, psi);
             for (j, l) in levers.iter().enumerate() {
                 let th = g.pin_angle(j);
@@ -314,7 +317,11 @@ mod tests {
                 assert!((jet.curvature_radius - reference.curvature_radius).abs() < 1e-9);
                 // d gap / d theta = -lever; classical lever to round-off.
                 assert!((jet.grad[2] + jet.lever()).abs() < 1e-15);
-                assert!((jet.lever() - l).abs() < 1e-13, "pin {j}: {} {l}", jet.lever());
+                assert!(
+                    (jet.lever() - l).abs() < 1e-13,
+                    "pin {j}: {} {l}",
+                    jet.lever()
+                );
             }
         }
     }
