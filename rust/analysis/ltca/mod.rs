@@ -260,7 +260,10 @@ impl Ltca {
 
     /// Equilibria at each crank angle in turn (each warm-started from the previous).
     pub fn sweep(&mut self, torque: f64, crank_angles: &[f64]) -> Result<Vec<LtcaPoint>> {
-        crank_angles.iter().map(|&p| self.solve(torque, p)).collect()
+        crank_angles
+            .iter()
+            .map(|&p| self.solve(torque, p))
+            .collect()
     }
 
     /// Output angle at equilibrium only (no contact details): the fast path of TE and loops.
@@ -295,7 +298,15 @@ impl Ltca {
         let mut r = vec![0.0; n];
         let mut k = Dense::zeros(n);
         let mut cs = ContactState::default();
-        st.eval(psi, q, torque, &mut r, &mut k, &mut self.work, Some(&mut cs))?;
+        st.eval(
+            psi,
+            q,
+            torque,
+            &mut r,
+            &mut k,
+            &mut self.work,
+            Some(&mut cs),
+        )?;
         let x = st.full(psi, q);
         let kin = st.kinematic_full(psi);
         let m = &st.model;
@@ -469,8 +480,9 @@ impl Ltca {
         let mut twist = Vec::with_capacity(points);
         let mut tangent = Vec::with_capacity(points);
         // At zero torque the equilibrium is any pose inside the clearances: the loop takes the
-        // limit along its branch (the torque 1e-9 rated on the side it comes from).
-        let eps = 1e-9 * rated;
+        // limit along its branch (a torque of 1e-7 rated on the side it comes from; the elastic
+        // twist at that torque is ~(1e-7)^(2/3) = 2e-5 of the rated one for Hertz contacts).
+        let eps = 1e-7 * rated;
         let mut side = 1.0;
         for &t in &torque {
             let ts = if t == 0.0 { side * eps } else { t };
@@ -491,6 +503,7 @@ impl Ltca {
         let rigidity = 2.0 * rated / (at(rated)? - at(-rated)?);
         let lost_motion = at(0.03 * rated)? - at(-0.03 * rated)?;
         let backlash = at(eps)? - at(-eps)?;
+        let _ = side;
         Ok(TwistLoop {
             crank_angle: psi,
             torque,
@@ -516,8 +529,8 @@ impl Ltca {
 /// laws, so it adds no period.)
 pub fn mesh_period(scene: &Scene) -> f64 {
     let e = &scene.pin_errors;
-    let errors = e.position.iter().any(|p| p[0] != 0.0 || p[1] != 0.0)
-        || e.radius.iter().any(|r| *r != 0.0);
+    let errors =
+        e.position.iter().any(|p| p[0] != 0.0 || p[1] != 0.0) || e.radius.iter().any(|r| *r != 0.0);
     if errors {
         TAU
     } else {

@@ -10,6 +10,8 @@
 //! Contacts that open or close need no active set: a contact law is zero (with zero
 //! derivative) for a positive gap.
 
+#![allow(clippy::needless_range_loop)]
+
 use crate::analysis::ltca::statics::{Dense, Statics, Work};
 use crate::error::{Result, RvdynError};
 
@@ -116,10 +118,11 @@ pub fn equilibrium(
     // ~eps |x| of round-off, times the stiffness).
     let rp = st.scale[0];
     let load = torque.abs() / rp;
-    let floor = 1e2 * f64::EPSILON * k_ref * rp;
+    let floor = 4.0 * f64::EPSILON * k_ref * rp;
     let done = (opts.tolerance * load).max(floor);
-    let stalled_ok = (1e-9 * load).max(1e2 * floor);
+    let stalled_ok = (1e-9 * load).max(10.0 * floor);
     let report_scale = load.max(1.0);
+    let max_pen = st.model.max_penetration;
     let force_scale = 1.0;
     let scale = st.scale.clone();
     let mut r = vec![0.0; n];
@@ -149,56 +152,101 @@ pub fn equilibrium(
                 mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
                 continue;
             }
-            // Line search along dq: backtrack while the residual grows; where nothing touches
-            // (inside a clearance the residual is flat: no contact force changes) expand the
-            // step until a contact closes instead.
+            // Line search along dq. The fast path is the full step when it reduces the
+            // residual. Otherwise a one-dimensional search for the minimum of the potential
+            // along dq, on its slope `s(a) = Q(q + a dq) . dq` (positive while the potential
+            // still falls): expand the step while the slope stays positive (inside a clearance
+            // nothing resists and the slope is the load's), then bisect to a point where the
+            // slope has fallen to half of its initial value or below (a strong-Wolfe condition,
+            // Nocedal and Wright section 3.1). No energy is needed.
+            let s0: f64 = r.iter().zip(&dq).map(|(a, b)| a * b).sum();
+            if s0.is_nan() || s0 <= 0.0 {
+                mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
+                continue;
+            }
             let mut trial = |step: f64, qt: &mut [f64], rt: &mut [f64], kt: &mut Dense| {
                 for i in 0..n {
                     qt[i] = q[i] + step * dq[i];
                 }
+                // A trial that moves any point by more than the penetration bound, or that
+                // penetrates beyond it, is rejected: a larger step could carry a disc through
+                // a pin onto the next lobe (the nearest-point gap would not notice).
+                let moved = dq
+                    .iter()
+                    .zip(scale.iter())
+                    .fold(0.0f64, |m, (d, l)| m.max((step * d * l).abs()));
+                if moved > max_pen {
+                    return None;
+                }
                 match st.eval(psi, qt, torque, rt, kt, work, None) {
-                    Ok(()) => Some(norms(rt, &scale, force_scale)),
+                    Ok(()) if st.max_penetration > max_pen => None,
+                    Ok(()) => {
+                        let (m2, n2) = norms(rt, &scale, force_scale);
+                        let slope: f64 = rt.iter().zip(dq.iter()).map(|(a, b)| a * b).sum();
+                        Some((m2, n2, slope))
+                    }
                     Err(_) => None,
                 }
             };
-            let decrease = |step: f64, t: Option<(f64, f64)>| {
-                t.is_some_and(|(m2, n2)| n2 < (1.0 - 1e-4 * step) * r2 || m2 <= done)
-            };
-            let flat = |t: Option<(f64, f64)>| t.is_some_and(|(_, n2)| (n2 - r2).abs() <= 1e-12 * r2);
             let mut chosen: Option<(f64, f64, f64)> = None;
             let first = trial(1.0, &mut qt, &mut rt, &mut kt);
-            if decrease(1.0, first) {
-                let (m2, n2) = first.unwrap_or_default();
+            if let Some((m2, n2, _)) = first
+                && (n2 < (1.0 - 1e-4) * r2 || m2 <= done)
+            {
                 chosen = Some((1.0, m2, n2));
-            } else if flat(first) {
-                let mut last_flat = 1.0;
-                let mut step = 1.0;
-                for _ in 0..60 {
-                    step *= 2.0;
-                    let t = trial(step, &mut qt, &mut rt, &mut kt);
-                    if decrease(step, t) {
-                        let (m2, n2) = t.unwrap_or_default();
-                        chosen = Some((step, m2, n2));
-                        break;
-                    }
-                    if !flat(t) {
-                        break;
-                    }
-                    last_flat = step;
-                }
-                if chosen.is_none() {
-                    chosen = Some((last_flat, rmax, r2));
-                }
+            } else if rmax <= stalled_ok {
+                // A full Newton step that cannot reduce a residual this small: round-off floor.
+                st.eval(psi, q, torque, &mut r, &mut k, work, None)?;
+                return Ok(NewtonReport {
+                    iterations: it,
+                    residual: rmax / report_scale,
+                });
             } else {
-                let mut step = 1.0;
-                for _ in 0..8 {
-                    step *= 0.5;
-                    let t = trial(step, &mut qt, &mut rt, &mut kt);
-                    if decrease(step, t) || flat(t) {
-                        let (m2, n2) = t.unwrap_or_default();
-                        chosen = Some((step, m2, n2));
-                        break;
+                let (mut lo, mut hi) = (0.0, 1.0);
+                let mut lo_norms = (rmax, r2);
+                if let Some((m2, n2, s1)) = first
+                    && s1 > 0.0
+                {
+                    lo = 1.0;
+                    lo_norms = (m2, n2);
+                    hi = f64::INFINITY;
+                    let mut step = 1.0;
+                    for _ in 0..60 {
+                        step *= 2.0;
+                        match trial(step, &mut qt, &mut rt, &mut kt) {
+                            Some((m2, n2, s)) if s > 0.0 => {
+                                lo = step;
+                                lo_norms = (m2, n2);
+                            }
+                            Some((m2, n2, s)) if s.abs() <= 0.5 * s0 => {
+                                chosen = Some((step, m2, n2));
+                                break;
+                            }
+                            _ => {
+                                hi = step;
+                                break;
+                            }
+                        }
                     }
+                }
+                if chosen.is_none() && hi.is_finite() {
+                    for _ in 0..40 {
+                        let mid = 0.5 * (lo + hi);
+                        match trial(mid, &mut qt, &mut rt, &mut kt) {
+                            Some((m2, n2, s)) if s.abs() <= 0.5 * s0 => {
+                                chosen = Some((mid, m2, n2));
+                                break;
+                            }
+                            Some((m2, n2, s)) if s > 0.0 => {
+                                lo = mid;
+                                lo_norms = (m2, n2);
+                            }
+                            _ => hi = mid,
+                        }
+                    }
+                }
+                if chosen.is_none() && lo > 0.0 {
+                    chosen = Some((lo, lo_norms.0, lo_norms.1));
                 }
             }
             if let Some((step, m2, n2)) = chosen {

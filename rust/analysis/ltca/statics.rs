@@ -178,6 +178,8 @@ pub struct Statics {
     pub scale: Vec<f64>,
     /// Foot parameter offset from the kinematic one per (disc, pin): the gap warm start.
     warm: Vec<f64>,
+    /// Largest contact penetration of the last evaluation [m].
+    pub max_penetration: f64,
 }
 
 impl Statics {
@@ -251,6 +253,7 @@ impl Statics {
             unknowns,
             scale,
             warm: vec![0.0; nd * zp],
+            max_penetration: 0.0,
             model,
         })
     }
@@ -399,6 +402,7 @@ impl Statics {
     ) -> Result<()> {
         qf.fill(0.0);
         kf.fill(0.0);
+        self.max_penetration = 0.0;
         let m = &self.model;
         let nd = m.discs.len();
         let zp = m.pins.len();
@@ -434,6 +438,7 @@ impl Statics {
                 let off = jet.phi - kin;
                 *w = if off.abs() < 0.05 { off } else { 0.0 };
                 let pen = -jet.gap;
+                self.max_penetration = self.max_penetration.max(pen);
                 let (f, fp) = elastic(&m.pin_law, pen);
                 if f > 0.0 || fp > 0.0 {
                     for a in 0..3 {
@@ -474,6 +479,7 @@ impl Statics {
                 let half = 0.5 * mm.backlash;
                 let sigma = if delta >= 0.0 { 1.0 } else { -1.0 };
                 let pen = sigma * delta - half;
+                self.max_penetration = self.max_penetration.max(pen);
                 let (f, fp) = elastic(&mm.law, pen);
                 let idx = [SUN, CARRIER, ci + 2, ci, ci + 1];
                 let grad = [
@@ -558,6 +564,7 @@ impl Statics {
 
     /// Static forces `r` and tangent stiffness `k = -dQ/dq` in the unknowns `q` at crank angle
     /// `psi` with the input held, for the output torque `torque` [N m].
+    #[allow(clippy::too_many_arguments)]
     pub fn eval(
         &mut self,
         psi: f64,

@@ -1,3 +1,5 @@
+#![allow(clippy::needless_range_loop)]
+
 use super::*;
 use crate::analysis::classical_pin_forces;
 use crate::dynamics::compliant::default_joints;
@@ -99,7 +101,11 @@ fn balances_close_and_zero_load_has_zero_te() {
         let mut ltca = Ltca::new(&s).unwrap();
         for psi in [0.0, 0.3, 2.0] {
             let p = ltca.solve(0.0, psi).unwrap();
-            assert!(p.transmission_error.abs() < 1e-12, "{:e}", p.transmission_error);
+            assert!(
+                p.transmission_error.abs() < 1e-12,
+                "{:e}",
+                p.transmission_error
+            );
             assert!(p.peak_pin_force() < 1e-6, "{}", p.peak_pin_force());
         }
     }
@@ -193,7 +199,11 @@ fn twist_loop_gives_rigidity_lost_motion_and_backlash() {
     u.joints = default_joints();
     let mut ltca = Ltca::new(&u).unwrap();
     let lp0 = ltca.twist_loop(rated(), 0.0, 9).unwrap();
-    assert!(lp0.backlash.abs() < 1e-3 * lp.backlash, "{:e}", lp0.backlash);
+    assert!(
+        lp0.backlash.abs() < 1e-3 * lp.backlash,
+        "{:e}",
+        lp0.backlash
+    );
 }
 
 /// TE over the true mesh period: the period check (TE at psi and psi + period agree), and
