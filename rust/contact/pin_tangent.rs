@@ -31,7 +31,7 @@ use crate::error::{Result, RvdynError, require_finite};
 use crate::geometry::CycloidGeometry;
 
 /// The gap of one pin against one disc with its derivatives in the disc pose `(X, Y, theta)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct GapJet {
     /// Signed gap [m] (negative = penetration).
     pub gap: f64,

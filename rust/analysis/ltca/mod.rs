@@ -143,6 +143,14 @@ pub struct TwistLoop {
     pub tangent_stiffness: Vec<f64>,
 }
 
+/// A solved equilibrium kept for warm starts.
+#[derive(Debug, Clone)]
+struct Solved {
+    psi: f64,
+    torque: f64,
+    q: Vec<f64>,
+}
+
 /// The loaded tooth contact analysis of one scene.
 #[derive(Debug, Clone)]
 pub struct Ltca {
@@ -150,7 +158,9 @@ pub struct Ltca {
     options: NewtonOptions,
     work: Work,
     /// Last solution `(psi, q)`: the warm start of the next.
-    last: Option<(f64, Vec<f64>)>,
+    last: Option<Solved>,
+    /// The solution before the last: with the last, a linear predictor.
+    before: Option<Solved>,
     k_ref: f64,
     face_width: f64,
     ratio: f64,
@@ -178,6 +188,7 @@ impl Ltca {
             options,
             work: Work::new(),
             last: None,
+            before: None,
             k_ref,
             face_width: scene.cycloid.face_width,
             ratio: scene.ratio(),
@@ -199,6 +210,7 @@ impl Ltca {
     /// Forget the warm start.
     pub fn reset(&mut self) {
         self.last = None;
+        self.before = None;
     }
 
     /// The equilibrium unknowns at `psi` and `torque`, warm-started from the last solution
@@ -208,15 +220,36 @@ impl Ltca {
         require_finite("crank angle", psi)?;
         let st = &mut self.statics;
         let kin = st.kinematic_unknowns(psi);
-        let mut q = match &self.last {
-            Some((p0, q0)) => {
-                let kin0 = st.kinematic_unknowns(*p0);
+        // Warm start: the last solution's deflection from its kinematic pose carried to this
+        // one; with two previous solutions along the same torque (or the same crank angle),
+        // extrapolated linearly in the crank angle (or the torque).
+        let deflection = |p: &Solved, st: &Statics| -> Vec<f64> {
+            let k = st.kinematic_unknowns(p.psi);
+            p.q.iter().zip(&k).map(|(a, b)| a - b).collect()
+        };
+        let mut q = match (&self.last, &self.before) {
+            (Some(l), Some(b)) => {
+                let d1 = deflection(l, st);
+                let d0 = deflection(b, st);
+                let w = if l.torque == torque && b.torque == torque && l.psi != b.psi {
+                    (psi - l.psi) / (l.psi - b.psi)
+                } else if l.psi == psi && b.psi == psi && l.torque != b.torque {
+                    (torque - l.torque) / (l.torque - b.torque)
+                } else {
+                    0.0
+                };
+                // Only interpolate or extrapolate one step ahead (a far jump is no predictor).
+                let w = if w.abs() <= 1.5 { w } else { 0.0 };
                 kin.iter()
-                    .zip(q0.iter().zip(&kin0))
-                    .map(|(k, (a, b))| k + (a - b))
+                    .zip(d1.iter().zip(&d0))
+                    .map(|(k, (a, b))| k + a + w * (a - b))
                     .collect()
             }
-            None => kin,
+            (Some(l), None) => {
+                let d1 = deflection(l, st);
+                kin.iter().zip(&d1).map(|(k, a)| k + a).collect()
+            }
+            _ => kin,
         };
         let rep = match equilibrium(
             st,
@@ -246,7 +279,12 @@ impl Ltca {
             }
             Err(e) => return Err(e),
         };
-        self.last = Some((psi, q.clone()));
+        self.before = self.last.take();
+        self.last = Some(Solved {
+            psi,
+            torque,
+            q: q.clone(),
+        });
         Ok((q, rep))
     }
 
@@ -275,30 +313,30 @@ impl Ltca {
         Ok((x[CARRIER], x[CARRIER] - kin))
     }
 
-    /// Analytic torsional stiffness `dT / d(output angle)` [N m/rad] at the unknowns `q`:
-    /// `1 / (K^-1)_00` (the output angle is unknown 0; the load enters as `-T e_0`).
-    fn tangent_stiffness(&mut self, torque: f64, psi: f64, q: &[f64]) -> Result<f64> {
-        let n = self.statics.dim();
-        let mut r = vec![0.0; n];
-        let mut k = Dense::zeros(n);
-        self.statics
-            .eval(psi, q, torque, &mut r, &mut k, &mut self.work, None)?;
-        let mut e0 = vec![0.0; n];
+    /// Analytic torsional stiffness `dT / d(output angle)` [N m/rad] at the last equilibrium
+    /// found: `1 / (K^-1)_00` (the output angle is unknown 0; the load enters as `-T e_0`).
+    fn last_tangent_stiffness(&mut self) -> f64 {
+        let mut k = self.work.k_last.clone();
+        let mut e0 = vec![0.0; k.n];
+        if k.n == 0 {
+            return 0.0;
+        }
         e0[0] = 1.0;
         if !solve_dense(&mut k, &mut e0) || e0[0] <= 0.0 {
-            return Ok(0.0);
+            return 0.0;
         }
-        Ok(1.0 / e0[0])
+        1.0 / e0[0]
     }
 
     fn point(&mut self, torque: f64, psi: f64, q: &[f64], rep: NewtonReport) -> Result<LtcaPoint> {
-        let stiff = self.tangent_stiffness(torque, psi, q)?;
         let st = &mut self.statics;
         let n = st.dim();
         let mut r = vec![0.0; n];
         let mut k = Dense::zeros(n);
         let mut cs = ContactState::default();
-        st.eval(
+        // Fresh gaps of every pin for the report (no separation skipping).
+        st.exact = true;
+        let evaluated = st.eval(
             psi,
             q,
             torque,
@@ -306,7 +344,16 @@ impl Ltca {
             &mut k,
             &mut self.work,
             Some(&mut cs),
-        )?;
+        );
+        st.exact = false;
+        evaluated?;
+        let mut e0 = vec![0.0; n];
+        e0[0] = 1.0;
+        let stiff = if solve_dense(&mut k, &mut e0) && e0[0] > 0.0 {
+            1.0 / e0[0]
+        } else {
+            0.0
+        };
         let x = st.full(psi, q);
         let kin = st.kinematic_full(psi);
         let m = &st.model;
@@ -493,7 +540,7 @@ impl Ltca {
             let x = self.statics.full(psi, &q);
             // Twist positive with positive torque: the load turns the output backwards.
             twist.push(-(x[CARRIER] + psi / self.statics.zc()));
-            tangent.push(self.tangent_stiffness(ts, psi, &q)?);
+            tangent.push(self.last_tangent_stiffness());
         }
         let mut at = |t: f64| -> Result<f64> {
             self.reset();

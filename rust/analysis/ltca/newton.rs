@@ -196,7 +196,7 @@ pub fn equilibrium(
                 chosen = Some((1.0, m2, n2));
             } else if rmax <= stalled_ok {
                 // A full Newton step that cannot reduce a residual this small: round-off floor.
-                st.eval(psi, q, torque, &mut r, &mut k, work, None)?;
+                work.k_last.clone_from(&k);
                 return Ok(NewtonReport {
                     iterations: it,
                     residual: rmax / report_scale,
@@ -250,10 +250,17 @@ pub fn equilibrium(
                 }
             }
             if let Some((step, m2, n2)) = chosen {
+                // The last trial is usually the chosen step: keep its evaluation.
+                let same = (0..n).all(|i| qt[i] == q[i] + step * dq[i]);
                 for i in 0..n {
                     q[i] += step * dq[i];
                 }
-                st.eval(psi, q, torque, &mut r, &mut k, work, None)?;
+                if same {
+                    std::mem::swap(&mut r, &mut rt);
+                    std::mem::swap(&mut k, &mut kt);
+                } else {
+                    st.eval(psi, q, torque, &mut r, &mut k, work, None)?;
+                }
                 rmax = m2;
                 r2 = n2;
                 accepted = true;
@@ -264,7 +271,7 @@ pub fn equilibrium(
             }
             // A full Newton step that cannot reduce a residual this small: round-off floor.
             if mu == 0.0 && rmax <= stalled_ok {
-                st.eval(psi, q, torque, &mut r, &mut k, work, None)?;
+                work.k_last.clone_from(&k);
                 return Ok(NewtonReport {
                     iterations: it,
                     residual: rmax / report_scale,
@@ -279,8 +286,7 @@ pub fn equilibrium(
             return Err(not_converged(psi, torque, rmax / report_scale, it));
         }
     }
-    // Leave the warm starts and the last evaluation at the solution.
-    st.eval(psi, q, torque, &mut r, &mut k, work, None)?;
+    work.k_last.clone_from(&k);
     Ok(NewtonReport {
         iterations: it,
         residual: rmax / report_scale,

@@ -26,6 +26,7 @@ use crate::contact::pin_tangent::{GapJet, gap_jet_cs};
 use crate::dynamics::rigid::RigidModel;
 use crate::dynamics::scene::{Bearing, Joints, Scene};
 use crate::error::{Result, RvdynError};
+use crate::geometry::gap::small_sin_cos;
 
 /// Index of the carrier angle in the full coordinates.
 pub const CARRIER: usize = 0;
@@ -180,6 +181,21 @@ pub struct Statics {
     warm: Vec<f64>,
     /// Largest contact penetration of the last evaluation [m].
     pub max_penetration: f64,
+    /// Number of evaluations so far (for benchmarks and reports).
+    pub evaluations: usize,
+    /// Skip the exact gap of pins that provably cannot touch (same forces, tested).
+    pub skip: bool,
+    /// Evaluate every pin exactly this time (fresh gaps for reports).
+    pub exact: bool,
+    /// Pin queries skipped so far.
+    pub skipped: usize,
+    /// Per (disc, pin): disc centre, angle and gap at the last exact query.
+    separation: Vec<([f64; 2], f64, f64)>,
+    last_jets: Vec<GapJet>,
+    /// `(cos, sin)` of each pin's nominal angle.
+    pin_dirs: Vec<[f64; 2]>,
+    /// Largest distance of a profile point from its disc centre [m].
+    reach: f64,
 }
 
 impl Statics {
@@ -254,6 +270,20 @@ impl Statics {
             scale,
             warm: vec![0.0; nd * zp],
             max_penetration: 0.0,
+            evaluations: 0,
+            skip: true,
+            exact: false,
+            skipped: 0,
+            separation: vec![([0.0; 2], 0.0, f64::NEG_INFINITY); nd * zp],
+            last_jets: vec![GapJet::default(); nd * zp],
+            pin_dirs: model.pins.iter().map(|p| cos_sin(p.angle)).collect(),
+            reach: (0..nd)
+                .map(|k| {
+                    let p = scene.disc_params(k);
+                    p.pin_circle_radius + p.d_rp + p.eccentricity - p.pin_radius - p.d_rrp
+                })
+                .fold(0.0, f64::max)
+                * 1.000_001,
             model,
         })
     }
@@ -403,6 +433,7 @@ impl Statics {
         qf.fill(0.0);
         kf.fill(0.0);
         self.max_penetration = 0.0;
+        self.evaluations += 1;
         let m = &self.model;
         let nd = m.discs.len();
         let zp = m.pins.len();
@@ -421,22 +452,50 @@ impl Statics {
             let o = [x[dk], x[dk + 1]];
             let th = x[dk + 2];
             let cs = cos_sin(th);
+            // (cos, sin) of -(theta + d_delta), to turn each pin's angle into its kinematic
+            // foot parameter without a sin_cos per pin.
+            let back = cos_sin(-th - d.geometry.params().d_delta);
             let idx = [dk, dk + 1, dk + 2];
             for (j, pin) in m.pins.iter().enumerate() {
+                let slot = k * zp + j;
+                // Skip a pin that provably cannot touch: moving the disc by dO and turning it
+                // by dth moves every profile point by at most |dO| + reach |dth|, and its gap
+                // by no more (the dynamic model's separation bound).
+                if self.skip && !self.exact {
+                    let b = &self.separation[slot];
+                    let moved =
+                        (o[0] - b.0[0]).hypot(o[1] - b.0[1]) + self.reach * (th - b.1).abs();
+                    if b.2 - moved > 0.0 {
+                        self.skipped += 1;
+                        if let Some(s) = state.as_deref_mut() {
+                            s.pin_force[slot] = 0.0;
+                            s.pin_gap[slot] = self.last_jets[slot].gap;
+                            s.pin_jet.push(self.last_jets[slot]);
+                        }
+                        continue;
+                    }
+                }
                 let kin = pin.angle - th - d.geometry.params().d_delta;
-                let w = &mut self.warm[k * zp + j];
+                let w = &mut self.warm[slot];
                 let seed = kin + *w;
-                let jet = gap_jet_cs(&d.geometry, pin.centre, pin.radius, o, cs, seed, None)
+                let kcs = rotate(back, self.pin_dirs[j]);
+                let (ds, dc) = small_sin_cos(*w);
+                let scs = [kcs[0] * dc - kcs[1] * ds, kcs[1] * dc + kcs[0] * ds];
+                let jet = gap_jet_cs(&d.geometry, pin.centre, pin.radius, o, cs, seed, Some(scs))
                     .ok_or_else(|| {
-                        RvdynError::Convergence(format!(
-                            "exact gap of pin {} on disc {k} not found: the disc is farther \
+                    RvdynError::Convergence(format!(
+                        "exact gap of pin {} on disc {k} not found: the disc is farther \
                              from its kinematic pose than the profile's radius of curvature \
                              (the contacts cannot carry this torque)",
-                            j + 1
-                        ))
-                    })?;
+                        j + 1
+                    ))
+                })?;
                 let off = jet.phi - kin;
-                *w = if off.abs() < 0.05 { off } else { 0.0 };
+                *w = if off.abs() < 0.01 { off } else { 0.0 };
+                if self.skip {
+                    self.separation[slot] = (o, th, jet.gap);
+                    self.last_jets[slot] = jet;
+                }
                 let pen = -jet.gap;
                 self.max_penetration = self.max_penetration.max(pen);
                 let (f, fp) = elastic(&m.pin_law, pen);
@@ -587,7 +646,11 @@ impl Statics {
         let n = self.dim();
         // Jacobian columns of the map (sparse: list of (full index, value) per unknown) and
         // the curvature terms sum_r Q_r hess(x_r).
-        work.jac.clear();
+        // Reuse the column vectors (no allocation per evaluation).
+        work.jac.resize_with(n, Vec::new);
+        for c in work.jac.iter_mut() {
+            c.clear();
+        }
         let thc = x[CARRIER];
         let u0 = cos_sin(thc);
         let seat = |i: usize| {
@@ -601,7 +664,8 @@ impl Statics {
         match self.kind {
             Kind::Rigid => {
                 // th_c: carrier, disc angles, crank seats.
-                let mut col = vec![(CARRIER, 1.0)];
+                let col = &mut work.jac[0];
+                col.push((CARRIER, 1.0));
                 for k in 0..m.discs.len() {
                     col.push((self.disc_index(k) + 2, 1.0));
                 }
@@ -611,9 +675,8 @@ impl Statics {
                     col.push((ci, ps[0]));
                     col.push((ci + 1, ps[1]));
                 }
-                work.jac.push(col);
                 if m.mesh.is_some() {
-                    let mut col = Vec::new();
+                    let col = &mut work.jac[1];
                     for i in 0..self.cranks {
                         col.push((self.crank_index(i) + 2, 1.0));
                     }
@@ -622,12 +685,12 @@ impl Statics {
                         col.push((dk, -x[dk + 1]));
                         col.push((dk + 1, x[dk]));
                     }
-                    work.jac.push(col);
                 }
             }
             Kind::Compliant => {
-                for &i in &self.unknowns {
-                    let mut col = vec![(i, 1.0)];
+                for (a, &i) in self.unknowns.iter().enumerate() {
+                    let col = &mut work.jac[a];
+                    col.push((i, 1.0));
                     if i == CARRIER && slaved_cranks {
                         for c in 0..self.cranks {
                             let ps = perp(seat(c));
@@ -636,7 +699,6 @@ impl Statics {
                             col.push((ci + 1, ps[1]));
                         }
                     }
-                    work.jac.push(col);
                 }
             }
         }
@@ -693,6 +755,8 @@ impl Statics {
 pub struct Work {
     pub qf: Vec<f64>,
     pub kf: Dense,
+    /// Tangent stiffness in the unknowns at the last equilibrium found.
+    pub k_last: Dense,
     jac: Vec<Vec<(usize, f64)>>,
 }
 
@@ -701,6 +765,7 @@ impl Work {
         Self {
             qf: Vec::new(),
             kf: Dense::zeros(0),
+            k_last: Dense::zeros(0),
             jac: Vec::new(),
         }
     }
@@ -875,6 +940,47 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Skipping pins that provably cannot touch changes no force or stiffness: along a loaded
+    /// sweep, the skipping evaluator and one that queries every pin agree to round-off.
+    #[test]
+    fn skipping_separated_pins_gives_the_same_forces() {
+        let mut scene = Scene::paper("rated").unwrap();
+        scene.cycloid.d_rrp = 2e-5;
+        scene.cycloid.d_rp = -2e-5;
+        scene.joints = crate::dynamics::compliant::default_joints();
+        let mut skipping = Statics::new(&scene).unwrap();
+        let mut fresh = Statics::new(&scene).unwrap();
+        fresh.skip = false;
+        let n = skipping.dim();
+        let (mut r1, mut r2) = (vec![0.0; n], vec![0.0; n]);
+        let (mut k1, mut k2) = (Dense::zeros(n), Dense::zeros(n));
+        let mut work = Work::new();
+        let mut rnd = rng(5);
+        let mut worst: f64 = 0.0;
+        let mut skipped = 0;
+        for i in 0..200 {
+            let psi = 0.002 * i as f64;
+            let mut q = skipping.kinematic_unknowns(psi);
+            q[0] -= 2e-4 + 1e-5 * rnd();
+            let mut cs = ContactState::default();
+            skipping
+                .eval(psi, &q, 4e4, &mut r1, &mut k1, &mut work, Some(&mut cs))
+                .unwrap();
+            fresh
+                .eval(psi, &q, 4e4, &mut r2, &mut k2, &mut work, None)
+                .unwrap();
+            for a in 0..n {
+                worst = worst.max((r1[a] - r2[a]).abs() / skipping.scale[a]);
+                for b in 0..n {
+                    worst = worst.max((k1.at(a, b) - k2.at(a, b)).abs() * 1e-9);
+                }
+            }
+            skipped = skipping.skipped;
+        }
+        assert!(worst == 0.0, "skipping changes the forces by {worst:e}");
+        assert!(skipped > 1000, "{skipped}");
     }
 
     /// The tangent stiffness equals central differences of the static forces.

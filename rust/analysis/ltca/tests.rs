@@ -252,3 +252,84 @@ fn bad_input_is_a_clear_error() {
     assert!(matches!(e, RvdynError::Convergence(_)));
     assert!(e.to_string().contains("crank angle"), "{e}");
 }
+#[test]
+fn scratch_speed() {
+    let mut s = Scene::paper("rated").unwrap();
+    s.joints = default_joints();
+    s.contact.pin = ContactLawSpec::Palmgren {
+        max_damping: 1e5,
+        damping_depth: 1e-5,
+    };
+    let mut ltca = Ltca::new(&s).unwrap();
+    let period = ltca.mesh_period();
+    ltca.solve(rated(), 0.0).unwrap();
+    let e0 = ltca.statics.evaluations;
+    let sk0 = ltca.statics.skipped;
+    let mut its = vec![];
+    for i in 1..40 {
+        let (_, rep) = ltca
+            .solve_unknowns(rated(), period * i as f64 / 360.0)
+            .unwrap();
+        its.push(rep.iterations);
+    }
+    println!(
+        "evals per angle {} skipped/eval {} its {:?}",
+        (ltca.statics.evaluations - e0) as f64 / 39.0,
+        (ltca.statics.skipped - sk0) as f64 / (ltca.statics.evaluations - e0) as f64,
+        its
+    );
+    let e0 = ltca.statics.evaluations;
+    ltca.twist_loop(rated(), 0.0, 200).unwrap();
+    println!("loop evals {}", ltca.statics.evaluations - e0);
+}
+#[test]
+fn scratch_eval_time() {
+    let mut s = Scene::paper("rated").unwrap();
+    s.joints = default_joints();
+    s.contact.pin = ContactLawSpec::Palmgren {
+        max_damping: 1e5,
+        damping_depth: 1e-5,
+    };
+    let mut ltca = Ltca::new(&s).unwrap();
+    let p = ltca.solve(rated(), 0.1).unwrap();
+    let _ = p;
+    let (q, _) = ltca.solve_unknowns(rated(), 0.1).unwrap();
+    let n = ltca.statics.dim();
+    let mut r = vec![0.0; n];
+    let mut k = Dense::zeros(n);
+    let mut w = Work::new();
+    let t0 = std::time::Instant::now();
+    for _ in 0..2000 {
+        ltca.statics
+            .eval(0.1, &q, rated(), &mut r, &mut k, &mut w, None)
+            .unwrap();
+    }
+    println!("eval {:?}", t0.elapsed() / 2000);
+    let x = ltca.statics.full(0.1, &q);
+    let t0 = std::time::Instant::now();
+    let mut qf = vec![0.0; x.len()];
+    let mut kf = Dense::zeros(x.len());
+    for _ in 0..2000 {
+        ltca.statics
+            .full_forces(&x, rated(), &mut qf, &mut kf, None)
+            .unwrap();
+    }
+    println!("full_forces {:?}", t0.elapsed() / 2000);
+    let g = &ltca.statics.model.discs[0].geometry;
+    let pin = ltca.statics.model.pins[3];
+    let t0 = std::time::Instant::now();
+    let mut acc = 0.0;
+    for i in 0..20000 {
+        let j = crate::contact::pin_tangent::pin_gap_jet(
+            g,
+            pin.centre,
+            pin.radius,
+            [x[11], x[12]],
+            x[13],
+            pin.angle - x[13] + 1e-9 * i as f64,
+        )
+        .unwrap();
+        acc += j.gap;
+    }
+    println!("jet {:?} {acc}", t0.elapsed() / 20000);
+}
