@@ -11,6 +11,7 @@
 //! [N m] acts on the carrier against positive rotation (as the scene's load), so a positive
 //! `T` is the forward drive.
 
+pub mod export;
 pub mod newton;
 pub mod statics;
 

@@ -333,3 +333,78 @@ fn scratch_eval_time() {
     }
     println!("jet {:?} {acc}", t0.elapsed() / 20000);
 }
+
+#[test]
+fn fea_loads_take_the_worst_crank_angle_of_each_disc() {
+    let mut s = Scene::paper("rated").unwrap();
+    s.cycloid.d_rrp = 2e-5;
+    s.cycloid.d_rp = -2e-5;
+    let mut ltca = Ltca::new(&s).unwrap();
+    let angles: Vec<f64> = (0..12).map(|i| 0.02 * i as f64).collect();
+    let points = ltca.sweep(rated(), &angles).unwrap();
+    let loads = export::worst_loads(&points).unwrap();
+    for k in 0..2 {
+        let worst = points
+            .iter()
+            .map(|p| p.pins[k].iter().fold(0.0f64, |m, l| m.max(l.force)))
+            .fold(0.0, f64::max);
+        let mine: Vec<_> = loads.iter().filter(|l| l.disc == k).collect();
+        let peak = mine.iter().fold(0.0f64, |m, l| m.max(l.force));
+        assert_eq!(peak, worst);
+        let psi = mine[0].crank_angle;
+        assert!(mine.iter().all(|l| l.crank_angle == psi && l.force > 0.0));
+        // The contact point is on the profile and the normal is a unit vector.
+        for l in &mine {
+            assert!((l.normal[0].hypot(l.normal[1]) - 1.0).abs() < 1e-12);
+            assert!(l.half_width > 0.0 && l.peak_pressure > 0.0);
+        }
+    }
+    let csv = export::loads_csv(&loads);
+    assert_eq!(csv.lines().count(), loads.len() + 1);
+    assert!(csv.starts_with(export::CSV_HEADER));
+    let json: serde_json::Value =
+        serde_json::from_str(&export::loads_json(&loads, 0.04).unwrap()).unwrap();
+    assert_eq!(json["format"], export::FORMAT);
+    assert_eq!(json["loads"].as_array().unwrap().len(), loads.len());
+    assert!(export::worst_loads(&[]).is_err());
+}
+
+/// The figures of the closing note (printed; run with `--ignored --nocapture`).
+#[test]
+#[ignore]
+fn figures() {
+    for (name, joints) in [("rigid", Joints::Rigid), ("compliant", default_joints())] {
+        for (label, d_rrp, d_rp) in [
+            ("unmodified", 0.0, 0.0),
+            ("d_rrp +20 um, d_rp -20 um", 2e-5, -2e-5),
+        ] {
+            let mut s = Scene::paper("rated").unwrap();
+            s.joints = joints;
+            s.cycloid.d_rrp = d_rrp;
+            s.cycloid.d_rp = d_rp;
+            let mut ltca = Ltca::new(&s).unwrap();
+            let period = ltca.mesh_period();
+            let angles: Vec<f64> = (0..90).map(|i| period * i as f64 / 90.0).collect();
+            let pts = ltca.sweep(rated(), &angles).unwrap();
+            let peak = pts.iter().map(|p| p.peak_pin_force()).fold(0.0, f64::max);
+            let lo = pts.iter().map(|p| p.loaded_pins[0]).min().unwrap();
+            let hi = pts.iter().map(|p| p.loaded_pins[0]).max().unwrap();
+            let te = ltca
+                .transmission_error(rated(), 1e-6 * rated(), 90, 0.0)
+                .unwrap();
+            let lp = ltca.twist_loop(rated(), 0.0, 81).unwrap();
+            println!(
+                "{name} {label}: loaded pins/disc {lo}-{hi}, peak pin force {:.1} kN, TE p-p fwd {:.3} arcsec rev {:.3} arcsec (mean fwd {:.2} rev {:.2} arcmin), unloaded TE p-p {:.4} arcsec, rigidity {:.1} N m/arcmin, lost motion {:.3} arcmin, backlash {:.3} arcmin",
+                peak / 1e3,
+                peak_to_peak(&te.forward) / ARCSEC,
+                peak_to_peak(&te.reverse) / ARCSEC,
+                te.forward.iter().sum::<f64>() / te.forward.len() as f64 / ARCMIN,
+                te.reverse.iter().sum::<f64>() / te.reverse.len() as f64 / ARCMIN,
+                peak_to_peak(&te.unloaded_forward) / ARCSEC,
+                lp.rigidity * ARCMIN,
+                lp.lost_motion / ARCMIN,
+                lp.backlash / ARCMIN,
+            );
+        }
+    }
+}
