@@ -1,0 +1,31 @@
+"""Quasi-static analysis: loaded tooth contact analysis (LTCA), transmission error in both
+drive directions, the torque-twist loop (rigidity, lost motion, backlash) and contact loads for
+FEA. The equilibria are computed by the Rust core (``rvdyn._core``); docs/model.md,
+"Quasi-static analysis", gives the formulation and conventions.
+
+Units are SI: N m, rad, m, N, Pa; results also offer arcmin/arcsec conversions.
+"""
+
+from __future__ import annotations
+
+from .ltca import (
+    ARCMIN,
+    ARCSEC,
+    LtcaResult,
+    TransmissionError,
+    TwistLoop,
+    ltca,
+    torque_twist,
+    transmission_error,
+)
+
+__all__ = [
+    "ARCMIN",
+    "ARCSEC",
+    "LtcaResult",
+    "TransmissionError",
+    "TwistLoop",
+    "ltca",
+    "torque_twist",
+    "transmission_error",
+]
