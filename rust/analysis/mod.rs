@@ -2,5 +2,6 @@
 
 pub mod load_sharing;
 pub mod ltca;
+pub mod modal;
 
 pub use load_sharing::{classical_levers, classical_pin_forces};

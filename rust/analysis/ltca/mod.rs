@@ -208,6 +208,11 @@ impl Ltca {
         self.ratio
     }
 
+    /// The unknowns of the last equilibrium found (empty before the first).
+    pub fn last_unknowns(&self) -> &[f64] {
+        self.last.as_ref().map_or(&[], |s| &s.q)
+    }
+
     /// Forget the warm start.
     pub fn reset(&mut self) {
         self.last = None;

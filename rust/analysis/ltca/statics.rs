@@ -150,6 +150,19 @@ pub struct ContactState {
     pub eccentric_bearing_force: Vec<[f64; 2]>,
 }
 
+/// A family of couplings (for strain-energy shares of modes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Family {
+    /// The pin contacts of disc `k`.
+    Pins(usize),
+    /// The sun/planet meshes.
+    Mesh,
+    /// The crank (main) bearings between the cranks and the carrier.
+    CrankBearings,
+    /// The eccentric (needle) bearings between the cranks and the discs.
+    EccentricBearings,
+}
+
 /// How the unknowns map to the full coordinates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
@@ -189,6 +202,11 @@ pub struct Statics {
     pub exact: bool,
     /// Pin queries skipped so far.
     pub skipped: usize,
+    /// Evaluate only this family of couplings (and no load) when set.
+    pub family: Option<Family>,
+    /// When set, [`Statics::full_forces`] also fills this damping matrix `C = -dQ/dv` in the
+    /// full coordinates (at zero velocity).
+    pub damping: Option<Dense>,
     /// Per (disc, pin): disc centre, angle and gap at the last exact query.
     separation: Vec<([f64; 2], f64, f64)>,
     last_jets: Vec<GapJet>,
@@ -274,6 +292,8 @@ impl Statics {
             skip: true,
             exact: false,
             skipped: 0,
+            family: None,
+            damping: None,
             separation: vec![([0.0; 2], 0.0, f64::NEG_INFINITY); nd * zp],
             last_jets: vec![GapJet::default(); nd * zp],
             pin_dirs: model.pins.iter().map(|p| cos_sin(p.angle)).collect(),
@@ -434,6 +454,15 @@ impl Statics {
         kf.fill(0.0);
         self.max_penetration = 0.0;
         self.evaluations += 1;
+        let fam = self.family;
+        let on = |f: Family| fam.is_none_or(|x| x == f);
+        let mut cf = self.damping.take();
+        if let Some(c) = cf.as_mut() {
+            if c.n != x.len() {
+                *c = Dense::zeros(x.len());
+            }
+            c.fill(0.0);
+        }
         let m = &self.model;
         let nd = m.discs.len();
         let zp = m.pins.len();
@@ -498,7 +527,16 @@ impl Statics {
                 }
                 let pen = -jet.gap;
                 self.max_penetration = self.max_penetration.max(pen);
-                let (f, fp) = elastic(&m.pin_law, pen);
+                let (f, fp) = if on(Family::Pins(k)) {
+                    elastic(&m.pin_law, pen)
+                } else {
+                    (0.0, 0.0)
+                };
+                if let Some(c) = cf.as_mut()
+                    && on(Family::Pins(k))
+                {
+                    c.outer(&idx, &jet.grad, contact_damping(&m.pin_law, pen));
+                }
                 if f > 0.0 || fp > 0.0 {
                     for a in 0..3 {
                         qf[idx[a]] += f * jet.grad[a];
@@ -539,7 +577,11 @@ impl Statics {
                 let sigma = if delta >= 0.0 { 1.0 } else { -1.0 };
                 let pen = sigma * delta - half;
                 self.max_penetration = self.max_penetration.max(pen);
-                let (f, fp) = elastic(&mm.law, pen);
+                let (f, fp) = if on(Family::Mesh) {
+                    elastic(&mm.law, pen)
+                } else {
+                    (0.0, 0.0)
+                };
                 let idx = [SUN, CARRIER, ci + 2, ci, ci + 1];
                 let grad = [
                     rbs,
@@ -548,6 +590,11 @@ impl Statics {
                     -w[0],
                     -w[1],
                 ];
+                if let Some(c) = cf.as_mut()
+                    && on(Family::Mesh)
+                {
+                    c.outer(&idx, &grad, contact_damping(&mm.law, pen));
+                }
                 if f > 0.0 || fp > 0.0 {
                     for a in 0..5 {
                         qf[idx[a]] -= sigma * f * grad[a];
@@ -564,7 +611,11 @@ impl Statics {
                 }
             }
             // Crank bearing: d = p - s(th_c).
-            if let Some(cb) = &self.crank_bearing {
+            if let Some(cb) = self
+                .crank_bearing
+                .as_ref()
+                .filter(|_| on(Family::CrankBearings))
+            {
                 let (g, h) = bearing_potential(cb, dcr);
                 // J_d: p -> I, th_c -> -perp(s).
                 let ps = perp(s);
@@ -574,13 +625,20 @@ impl Statics {
                     (CARRIER, [-ps[0], -ps[1]]),
                 ];
                 add_bearing(qf, kf, &cols, g, h);
+                if let Some(c) = cf.as_mut() {
+                    add_bearing_damping(c, &cols, bearing_damping(cb, dcr));
+                }
                 kf.add(CARRIER, CARRIER, dot(g, s));
                 if let Some(st) = state.as_deref_mut() {
                     st.crank_bearing_force.push([-g[0], -g[1]]);
                 }
             }
             // Eccentric bearings (i, k): d = O_k + R(theta_k) h_ik - p_i - eps_ik(alpha_i).
-            if let Some(eb) = &self.eccentric_bearing {
+            if let Some(eb) = self
+                .eccentric_bearing
+                .as_ref()
+                .filter(|_| on(Family::EccentricBearings))
+            {
                 for (k, disc) in m.discs.iter().enumerate() {
                     let dk = self.disc_index(k);
                     let ecc = {
@@ -604,6 +662,9 @@ impl Statics {
                         (ci + 2, [-pe[0], -pe[1]]),
                     ];
                     add_bearing(qf, kf, &cols, g, h);
+                    if let Some(c) = cf.as_mut() {
+                        add_bearing_damping(c, &cols, bearing_damping(eb, d));
+                    }
                     kf.add(dk + 2, dk + 2, -dot(g, arm));
                     kf.add(ci + 2, ci + 2, dot(g, ecc));
                     if let Some(st) = state.as_deref_mut() {
@@ -612,7 +673,10 @@ impl Statics {
                 }
             }
         }
-        qf[CARRIER] -= torque;
+        if fam.is_none() {
+            qf[CARRIER] -= torque;
+        }
+        self.damping = cf;
         if !qf.iter().all(|v| v.is_finite()) || !kf.a.iter().all(|v| v.is_finite()) {
             return Err(RvdynError::Convergence(
                 "non-finite static force or stiffness: the pose is far from equilibrium".into(),
@@ -737,6 +801,25 @@ impl Statics {
         Ok(())
     }
 
+    /// `J^T A J` of a full-coordinate matrix `a` with the map Jacobian of the last
+    /// [`Statics::eval`] (velocities map linearly: no curvature terms).
+    pub fn reduce(&self, a: &Dense, work: &Work) -> Dense {
+        let n = self.dim();
+        let mut out = Dense::zeros(n);
+        for p in 0..n {
+            for b in 0..n {
+                let mut s = 0.0;
+                for &(i, vi) in &work.jac[p] {
+                    for &(j, vj) in &work.jac[b] {
+                        s += vi * a.at(i, j) * vj;
+                    }
+                }
+                out.a[p * n + b] = s;
+            }
+        }
+        out
+    }
+
     /// The torque the held input carries [N m] (the reaction that holds it): minus the
     /// generalised force on the input coordinates in the last full evaluation.
     pub fn input_reaction(&self, work: &Work) -> f64 {
@@ -785,6 +868,47 @@ pub fn elastic(law: &ImpactLaw, pen: f64) -> (f64, f64) {
     }
     let (f, df, _) = law.force_and_derivatives(pen, 0.0);
     (f, df)
+}
+
+/// Damping coefficient [N s/m] of a contact law at penetration `pen` [m] (at zero rate).
+#[inline]
+pub fn contact_damping(law: &ImpactLaw, pen: f64) -> f64 {
+    if pen <= 0.0 {
+        return 0.0;
+    }
+    law.force_and_derivatives(pen, 0.0).2
+}
+
+/// Damping matrix `dF/dd'` [N s/m] of a bearing at deflection `d` (at zero rate): `c I`
+/// without clearance, `c n n^T` beyond the clearance, 0 inside it.
+#[inline]
+fn bearing_damping(b: &Bearing, d: [f64; 2]) -> [[f64; 2]; 2] {
+    if b.clearance <= 0.0 {
+        return [[b.damping, 0.0], [0.0, b.damping]];
+    }
+    let len = dot(d, d).sqrt();
+    if len <= b.clearance {
+        return [[0.0; 2]; 2];
+    }
+    let n = [d[0] / len, d[1] / len];
+    [
+        [b.damping * n[0] * n[0], b.damping * n[0] * n[1]],
+        [b.damping * n[1] * n[0], b.damping * n[1] * n[1]],
+    ]
+}
+
+/// Add `J_d^T c J_d` for a bearing with deflection Jacobian columns `cols`.
+#[inline]
+fn add_bearing_damping(cm: &mut Dense, cols: &[(usize, [f64; 2])], c: [[f64; 2]; 2]) {
+    for &(i, ji) in cols {
+        let cj = [
+            c[0][0] * ji[0] + c[0][1] * ji[1],
+            c[1][0] * ji[0] + c[1][1] * ji[1],
+        ];
+        for &(j, jj) in cols {
+            cm.add(j, i, dot(jj, cj));
+        }
+    }
 }
 
 /// Add a bearing's force and stiffness: deflection Jacobian columns `cols` (full index,
