@@ -63,7 +63,7 @@ pub fn modes(scene: &Scene, torque: f64, psi: f64) -> Result<Modal> {
     let mut st = Statics::new(scene)?;
     let n = st.dim();
     let (mass, dofs) = masses(scene, &st)?;
-    if let Some((i, _)) = mass.iter().enumerate().find(|(_, m)| !(**m > 0.0)) {
+    if let Some((i, _)) = mass.iter().enumerate().find(|(_, m)| m.is_nan() || **m <= 0.0) {
         return Err(RvdynError::Scene(format!(
             "the degree of freedom {} has no mass or inertia: give the body a positive mass \
              (scene.inertias)",
