@@ -6,7 +6,7 @@
 //! `K = -dQ/dq` and the damping `C = -dQ/dv` (contact and bearing dampers at zero velocity).
 //! Undamped modes from the symmetric problem `M^-1/2 K M^-1/2 v = w^2 v`, shapes
 //! `phi = M^-1/2 v` (mass-normalised); modal damping ratios `zeta = phi^T C phi / (2 w)` (the
-//! diagonal of the modal damping matrix: light, non-proportional damping; Gerad & Rixen,
+//! diagonal of the modal damping matrix: light, non-proportional damping; Geradin & Rixen,
 //! *Mechanical Vibrations*, 3rd ed., 2015, section 2.7); the share of each coupling family in a
 //! mode's strain energy `phi^T K_f phi / phi^T K phi`.
 
