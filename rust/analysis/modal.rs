@@ -63,7 +63,11 @@ pub fn modes(scene: &Scene, torque: f64, psi: f64) -> Result<Modal> {
     let mut st = Statics::new(scene)?;
     let n = st.dim();
     let (mass, dofs) = masses(scene, &st)?;
-    if let Some((i, _)) = mass.iter().enumerate().find(|(_, m)| m.is_nan() || **m <= 0.0) {
+    if let Some((i, _)) = mass
+        .iter()
+        .enumerate()
+        .find(|(_, m)| m.is_nan() || **m <= 0.0)
+    {
         return Err(RvdynError::Scene(format!(
             "the degree of freedom {} has no mass or inertia: give the body a positive mass \
              (scene.inertias)",
@@ -151,6 +155,103 @@ pub fn modes(scene: &Scene, torque: f64, psi: f64) -> Result<Modal> {
         mass,
         modes: out,
     })
+}
+
+/// Natural frequencies [Hz] at `points` crank angles over one mesh period (the stiffness varies
+/// with the crank angle): `(crank angles [rad], frequencies [point][mode])`.
+pub fn modes_over_period(
+    scene: &Scene,
+    torque: f64,
+    points: usize,
+) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+    if points == 0 {
+        return Err(RvdynError::Parameter(
+            "modes over a mesh period need at least one crank angle".into(),
+        ));
+    }
+    let period = crate::analysis::ltca::mesh_period(scene);
+    let angles: Vec<f64> = (0..points)
+        .map(|i| period * i as f64 / points as f64)
+        .collect();
+    let freqs = angles
+        .iter()
+        .map(|&p| modes(scene, torque, p).map(|m| m.modes.iter().map(|x| x.frequency).collect()))
+        .collect::<Result<Vec<Vec<f64>>>>()?;
+    Ok((angles, freqs))
+}
+
+/// The excitation orders of a scene, as multiples of the input rotation frequency
+/// (docs/model.md, "Excitation orders"): carrier `1/i`, crank and disc-centre orbit `zc/i`,
+/// pin-pass `zp zc / i` and its 2nd and 3rd harmonics, and with a first stage the input `1`
+/// and the sun mesh `z_s (i - 1)/i`.
+pub fn excitation_orders(scene: &Scene) -> Vec<(String, f64)> {
+    let i = scene.ratio().abs();
+    let zp = f64::from(scene.cycloid.pins);
+    let zc = zp - 1.0;
+    let mut out = vec![
+        ("carrier (output)".to_string(), 1.0 / i),
+        ("crank orbit".to_string(), zc / i),
+        ("pin pass".to_string(), zp * zc / i),
+        ("pin pass x2".to_string(), 2.0 * zp * zc / i),
+        ("pin pass x3".to_string(), 3.0 * zp * zc / i),
+    ];
+    if let Some(s) = &scene.stage1 {
+        out.push(("input".to_string(), 1.0));
+        out.push(("sun mesh".to_string(), f64::from(s.z_sun) * (i - 1.0) / i));
+    }
+    out
+}
+
+/// One crossing of an excitation order with a natural frequency in a Campbell diagram.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Crossing {
+    pub order: String,
+    /// Order value (multiple of the input rotation frequency).
+    pub order_value: f64,
+    /// Index of the mode (sorted by frequency).
+    pub mode: usize,
+    /// Natural frequency [Hz].
+    pub frequency: f64,
+    /// Input speed at the crossing [rad/s]: `2 pi f / order`.
+    pub input_speed: f64,
+}
+
+/// The crossings of `orders` with the natural frequencies `frequencies` [Hz] for input speeds
+/// in `[speed_min, speed_max]` [rad/s] (the natural frequencies of the linearised model do not
+/// depend on the speed). Errors (`Parameter`) for a speed range that is not finite, not
+/// positive or empty.
+pub fn campbell_crossings(
+    frequencies: &[f64],
+    orders: &[(String, f64)],
+    speed_min: f64,
+    speed_max: f64,
+) -> Result<Vec<Crossing>> {
+    if !(speed_min.is_finite()
+        && speed_max.is_finite()
+        && speed_min >= 0.0
+        && speed_max > speed_min)
+    {
+        return Err(RvdynError::Parameter(format!(
+            "the Campbell speed range must satisfy 0 <= min < max (finite, rad/s), got              [{speed_min}, {speed_max}]"
+        )));
+    }
+    let mut out = Vec::new();
+    for (name, order) in orders {
+        for (m, &f) in frequencies.iter().enumerate() {
+            let w = std::f64::consts::TAU * f / order;
+            if w >= speed_min && w <= speed_max {
+                out.push(Crossing {
+                    order: name.clone(),
+                    order_value: *order,
+                    mode: m,
+                    frequency: f,
+                    input_speed: w,
+                });
+            }
+        }
+    }
+    out.sort_by(|a, b| a.input_speed.total_cmp(&b.input_speed));
+    Ok(out)
 }
 
 /// Diagonal masses and names of the unknowns of `st`.
@@ -281,6 +382,27 @@ mod tests {
             modal.families,
             vec!["pins of disc 0", "pins of disc 1", "sun/planet meshes"]
         );
+    }
+
+    #[test]
+    fn orders_and_campbell_crossings() {
+        let s = Scene::paper("rated").unwrap();
+        let orders = excitation_orders(&s);
+        let pin = orders.iter().find(|o| o.0 == "pin pass").unwrap().1;
+        assert!((pin - 552.0 / 57.0).abs() < 1e-12);
+        let mesh = orders.iter().find(|o| o.0 == "sun mesh").unwrap().1;
+        assert!((mesh - 1008.0 / 57.0).abs() < 1e-12);
+        // A 224.03 Hz mode is crossed by the pin-pass order at the paper's input speed.
+        let w_in = 8328f64.to_radians();
+        let f = pin * w_in / std::f64::consts::TAU;
+        let c = campbell_crossings(&[f], &orders, 0.5 * w_in, 2.0 * w_in).unwrap();
+        let hit = c.iter().find(|x| x.order == "pin pass").unwrap();
+        assert!((hit.input_speed / w_in - 1.0).abs() < 1e-12);
+        assert!((f - 224.03).abs() < 0.01);
+        assert!(campbell_crossings(&[f], &orders, 1.0, 0.5).is_err());
+        let (angles, freqs) = modes_over_period(&s, 43_921.3, 3).unwrap();
+        assert_eq!(angles.len(), 3);
+        assert!(freqs.iter().all(|f| f.len() == 2 && f[0] > 0.0));
     }
 
     #[test]
