@@ -537,19 +537,34 @@ impl Ltca {
         // twist at that torque is ~(1e-7)^(2/3) = 2e-5 of the rated one for Hertz contacts).
         let eps = 1e-7 * rated;
         let mut side = 1.0;
+        let mut solved: Vec<(f64, Vec<f64>)> = Vec::with_capacity(points);
         for &t in &torque {
             let ts = if t == 0.0 { side * eps } else { t };
             if t != 0.0 {
                 side = t.signum();
             }
             let (q, _) = self.solve_unknowns(ts, psi)?;
+            solved.push((ts, q.clone()));
             let x = self.statics.full(psi, &q);
             // Twist positive with positive torque: the load turns the output backwards.
             twist.push(-(x[CARRIER] + psi / self.statics.zc()));
             tangent.push(self.last_tangent_stiffness());
         }
+        // The catalogue points, each warm-started from the loop point nearest in torque on the
+        // same side of zero.
         let mut at = |t: f64| -> Result<f64> {
             self.reset();
+            if let Some((t0, q0)) = solved
+                .iter()
+                .filter(|(s, _)| s.signum() == t.signum())
+                .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+            {
+                self.last = Some(Solved {
+                    psi,
+                    torque: *t0,
+                    q: q0.clone(),
+                });
+            }
             let (_, dev) = self.output_angle(t, psi)?;
             Ok(-dev)
         };

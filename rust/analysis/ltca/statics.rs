@@ -504,27 +504,38 @@ impl Statics {
                         continue;
                     }
                 }
-                let kin = pin.angle - th - d.geometry.params().d_delta;
-                let w = &mut self.warm[slot];
-                let seed = kin + *w;
-                let kcs = rotate(back, self.pin_dirs[j]);
-                let (ds, dc) = small_sin_cos(*w);
-                let scs = [kcs[0] * dc - kcs[1] * ds, kcs[1] * dc + kcs[0] * ds];
-                let jet = gap_jet_cs(&d.geometry, pin.centre, pin.radius, o, cs, seed, Some(scs))
-                    .ok_or_else(|| {
-                    RvdynError::Convergence(format!(
-                        "exact gap of pin {} on disc {k} not found: the disc is farther \
-                             from its kinematic pose than the profile's radius of curvature \
-                             (the contacts cannot carry this torque)",
-                        j + 1
-                    ))
-                })?;
-                let off = jet.phi - kin;
-                *w = if off.abs() < 0.01 { off } else { 0.0 };
-                if self.skip {
-                    self.separation[slot] = (o, th, jet.gap);
-                    self.last_jets[slot] = jet;
-                }
+                // The same pose as this pin's last exact query: the same jet.
+                let same = self.skip && {
+                    let b = &self.separation[slot];
+                    b.0 == o && b.1 == th && b.2.is_finite()
+                };
+                let jet = if same {
+                    self.last_jets[slot]
+                } else {
+                    let kin = pin.angle - th - d.geometry.params().d_delta;
+                    let w = &mut self.warm[slot];
+                    let seed = kin + *w;
+                    let kcs = rotate(back, self.pin_dirs[j]);
+                    let (ds, dc) = small_sin_cos(*w);
+                    let scs = [kcs[0] * dc - kcs[1] * ds, kcs[1] * dc + kcs[0] * ds];
+                    let jet =
+                        gap_jet_cs(&d.geometry, pin.centre, pin.radius, o, cs, seed, Some(scs))
+                            .ok_or_else(|| {
+                                RvdynError::Convergence(format!(
+                                    "exact gap of pin {} on disc {k} not found: the disc is \
+                                     farther from its kinematic pose than the profile's radius \
+                                     of curvature (the contacts cannot carry this torque)",
+                                    j + 1
+                                ))
+                            })?;
+                    let off = jet.phi - kin;
+                    *w = if off.abs() < 0.01 { off } else { 0.0 };
+                    if self.skip {
+                        self.separation[slot] = (o, th, jet.gap);
+                        self.last_jets[slot] = jet;
+                    }
+                    jet
+                };
                 let pen = -jet.gap;
                 self.max_penetration = self.max_penetration.max(pen);
                 let (f, fp) = if on(Family::Pins(k)) {

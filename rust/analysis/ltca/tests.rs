@@ -408,3 +408,51 @@ fn figures() {
         }
     }
 }
+#[test]
+#[ignore]
+fn scratch_cpu_time() {
+    fn cpu() -> f64 {
+        let s = std::fs::read_to_string("/proc/thread-self/stat").unwrap();
+        let rest = &s[s.rfind(')').unwrap() + 2..];
+        let f: Vec<&str> = rest.split_whitespace().collect();
+        (f[11].parse::<f64>().unwrap() + f[12].parse::<f64>().unwrap()) / 100.0
+    }
+    let mut s = Scene::paper("rated").unwrap();
+    s.joints = default_joints();
+    s.contact.pin = ContactLawSpec::Palmgren {
+        max_damping: 1e5,
+        damping_depth: 1e-5,
+    };
+    let mut ltca = Ltca::new(&s).unwrap();
+    let period = ltca.mesh_period();
+    let angles: Vec<f64> = (0..360).map(|i| period * i as f64 / 360.0).collect();
+    let t0 = cpu();
+    let reps = 100;
+    for _ in 0..reps {
+        ltca.reset();
+        ltca.sweep(rated(), &angles).unwrap();
+    }
+    let sweep = (cpu() - t0) / reps as f64;
+    let t0 = cpu();
+    let mut n = 0;
+    for _ in 0..reps {
+        ltca.reset();
+        for &a in &angles {
+            ltca.solve_unknowns(rated(), a).unwrap();
+            n += 1;
+        }
+    }
+    let bare = (cpu() - t0) / n as f64;
+    let t0 = cpu();
+    for _ in 0..reps {
+        ltca.twist_loop(rated(), 0.0, 200).unwrap();
+    }
+    let lp = (cpu() - t0) / reps as f64;
+    println!(
+        "CPU: sweep 360 {:.2} ms ({:.1} us/angle with reports), equilibrium only {:.1} us/angle, loop 200 {:.2} ms",
+        sweep * 1e3,
+        sweep / 360.0 * 1e6,
+        bare * 1e6,
+        lp * 1e3
+    );
+}
