@@ -425,7 +425,9 @@ mod tests {
     }
 }
 #[cfg(test)]
-mod scratch {
+mod table {
+    /// The mode table of the compliant paper scene at rated load (printed; run with
+    /// `--ignored --nocapture`).
     #[test]
     #[ignore]
     fn print_modes() {
