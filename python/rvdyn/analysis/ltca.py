@@ -274,7 +274,7 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
     step = max(int(chunk), 1)
     for start in range(0, angles.size, step):
         # The solver keeps its warm start and its points across chunks.
-        parts.append(solver.sweep(t, angles[start:start + step]))
+        parts.append(solver.sweep(t, angles[start:start + step].tolist()))
         if progress is not None:
             progress(min(start + step, angles.size), angles.size)
     arrays = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
