@@ -98,12 +98,6 @@ def campbell(scene: Scene, speeds: Any, torque: float | None = None, crank_angle
         raise ParameterError("speeds must be a 1-D array of at least 2 finite input speeds >= 0 [rad/s]")
     m = modes(sc, torque, crank_angle)
     orders = [(str(n), float(o)) for n, o in _core.excitation_orders(sc._compiled)]
-    crossings = []
-    for name, order in orders:
-        for i, f in enumerate(m.frequency):
-            ws = 2.0 * math.pi * f / order
-            if w.min() <= ws <= w.max():
-                crossings.append({"order": name, "order_value": order, "mode": i + 1,
-                                  "frequency": float(f), "input_speed": ws})
-    crossings.sort(key=lambda c: c["input_speed"])
+    crossings = [dict(c) for c in _core.campbell_crossings(m.frequency.tolist(), orders, float(w.min()),
+                                                            float(w.max()))]
     return Campbell(speeds=w, frequencies=m.frequency, orders=orders, crossings=crossings)
