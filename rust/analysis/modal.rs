@@ -34,7 +34,9 @@ pub struct Mode {
 /// The modes of a scene about one loaded equilibrium.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Modal {
+    /// Crank angle of the equilibrium [rad].
     pub crank_angle: f64,
+    /// Output torque of the equilibrium [N m].
     pub torque: f64,
     /// Names of the degrees of freedom.
     pub dofs: Vec<String>,

@@ -83,6 +83,7 @@ pub struct LtcaPoint {
     /// Largest residual of the equilibrium equations (every free coordinate of every body),
     /// relative to the load scale.
     pub residual: f64,
+    /// Newton iterations used.
     pub iterations: usize,
     /// Torsional stiffness `dT / d(output angle)` at this equilibrium [N m/rad], analytic.
     pub torsional_stiffness: f64,

@@ -83,6 +83,7 @@ impl Default for NewtonOptions {
 /// How one equilibrium was reached.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonReport {
+    /// Newton iterations used.
     pub iterations: usize,
     /// Largest scaled residual relative to the force scale.
     pub residual: f64,

@@ -54,25 +54,31 @@ fn cos_sin(a: f64) -> [f64; 2] {
 /// A dense symmetric-by-construction matrix of size `n` (row-major).
 #[derive(Debug, Clone)]
 pub struct Dense {
+    /// Size.
     pub n: usize,
+    /// Entries, row-major.
     pub a: Vec<f64>,
 }
 
 impl Dense {
+    /// The zero matrix of size `n`.
     pub fn zeros(n: usize) -> Self {
         Self {
             n,
             a: vec![0.0; n * n],
         }
     }
+    /// Entry `(i, j)`.
     #[inline]
     pub fn at(&self, i: usize, j: usize) -> f64 {
         self.a[i * self.n + j]
     }
+    /// Add `v` to entry `(i, j)`.
     #[inline]
     pub fn add(&mut self, i: usize, j: usize, v: f64) {
         self.a[i * self.n + j] += v;
     }
+    /// Set every entry to `v`.
     pub fn fill(&mut self, v: f64) {
         self.a.fill(v);
     }
