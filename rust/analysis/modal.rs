@@ -207,6 +207,7 @@ pub fn excitation_orders(scene: &Scene) -> Vec<(String, f64)> {
 /// One crossing of an excitation order with a natural frequency in a Campbell diagram.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Crossing {
+    /// Name of the order.
     pub order: String,
     /// Order value (multiple of the input rotation frequency).
     pub order_value: f64,

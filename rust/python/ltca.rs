@@ -9,11 +9,13 @@ use crate::python::scene::CompiledScene;
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::sync::Mutex;
 
 /// The loaded tooth contact analysis of one scene (use `rvdyn.analysis`, which wraps it).
 #[pyclass(name = "LtcaSolver", module = "rvdyn._core")]
 pub(crate) struct LtcaSolver {
-    ltca: Ltca,
+    /// Behind a mutex: the core keeps per-contact warm starts in cells (not `Sync`).
+    ltca: Mutex<Ltca>,
     face_width: f64,
     /// Every point solved by `sweep` since construction (for the FEA loads).
     points: Vec<LtcaPoint>,
@@ -43,7 +45,7 @@ impl LtcaSolver {
             .into());
         }
         Ok(Self {
-            ltca: Ltca::with_options(&scene.scene, opts)?,
+            ltca: Mutex::new(Ltca::with_options(&scene.scene, opts)?),
             face_width: scene.scene.cycloid.face_width,
             points: Vec::new(),
         })
@@ -51,14 +53,14 @@ impl LtcaSolver {
 
     /// Crank-angle period of the contact pattern [rad].
     #[getter]
-    fn mesh_period(&self) -> f64 {
-        self.ltca.mesh_period()
+    fn mesh_period(&self) -> PyResult<f64> {
+        Ok(self.lock()?.mesh_period())
     }
 
     /// Transmission ratio input/output.
     #[getter]
-    fn ratio(&self) -> f64 {
-        self.ltca.ratio()
+    fn ratio(&self) -> PyResult<f64> {
+        Ok(self.lock()?.ratio())
     }
 
     /// Disc face width [m].
@@ -75,7 +77,7 @@ impl LtcaSolver {
         torque: f64,
         crank_angles: Vec<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let ltca = &mut self.ltca;
+        let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
         let pts = py.detach(|| ltca.sweep(torque, &crank_angles))?;
         let d = pack(py, &pts)?;
         self.points.extend(pts);
@@ -98,7 +100,7 @@ impl LtcaSolver {
         points: usize,
         start: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let ltca = &mut self.ltca;
+        let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
         let te = py.detach(|| ltca.transmission_error(torque, light, points, start))?;
         let d = PyDict::new(py);
         let n = te.crank_angle.len();
@@ -119,7 +121,7 @@ impl LtcaSolver {
         crank_angle: f64,
         points: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let ltca = &mut self.ltca;
+        let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
         let lp = py.detach(|| ltca.twist_loop(rated, crank_angle, points))?;
         let d = PyDict::new(py);
         let n = lp.torque.len();
@@ -134,6 +136,17 @@ impl LtcaSolver {
         d.set_item("backlash", lp.backlash)?;
         Ok(d)
     }
+}
+
+impl LtcaSolver {
+    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, Ltca>> {
+        self.ltca.lock().map_err(|_| poisoned())
+    }
+}
+
+fn poisoned() -> PyErr {
+    RvdynError::Convergence("the LTCA solver failed in an earlier call; build a new one".into())
+        .into()
 }
 
 /// LTCA points as arrays (first axis: crank angle).

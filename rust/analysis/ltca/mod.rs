@@ -106,13 +106,17 @@ pub struct TransmissionError {
     pub crank_angle: Vec<f64>,
     /// Period of the mesh in crank angle [rad].
     pub period: f64,
-    /// TE at `+torque` (forward drive) and at `-torque` (reverse) [rad].
+    /// TE at `+torque` (forward drive) [rad].
     pub forward: Vec<f64>,
+    /// TE at `-torque` (reverse drive) [rad].
     pub reverse: Vec<f64>,
-    /// TE at a light load (`+-light` N m) [rad]: the geometric (unloaded) TE.
+    /// TE at the light load `+light` [rad]: the geometric (unloaded) TE, forward.
     pub unloaded_forward: Vec<f64>,
+    /// TE at `-light` [rad]: the unloaded TE, reverse.
     pub unloaded_reverse: Vec<f64>,
+    /// Loaded torque [N m].
     pub torque: f64,
+    /// Light torque of the unloaded TE [N m].
     pub light: f64,
 }
 
@@ -129,11 +133,13 @@ pub fn peak_to_peak(v: &[f64]) -> f64 {
 /// The torque-twist loop at one crank angle with rigidity, lost motion and backlash.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TwistLoop {
+    /// Crank angle of the loop [rad].
     pub crank_angle: f64,
     /// Output torque along the loop [N m] (0 -> +rated -> -rated -> 0).
     pub torque: Vec<f64>,
     /// Output twist relative to the held input [rad] (positive with positive torque).
     pub twist: Vec<f64>,
+    /// Rated torque of the loop [N m].
     pub rated_torque: f64,
     /// Catalogue torsional rigidity `2 T_r / (twist(+T_r) - twist(-T_r))` [N m/rad].
     pub rigidity: f64,
@@ -184,7 +190,8 @@ impl Ltca {
         let (f, _) = statics::elastic(&law, 1e-5);
         let mut k_ref = f / 1e-5;
         if let Some(b) = statics.eccentric_bearing {
-            k_ref = k_ref.max(b.stiffness);
+            // The bearing's stiffness at a 1 mm deflection (beyond any clearance it has).
+            k_ref = k_ref.max(b.static_tangent([1e-3, 0.0]).1[0][0]);
         }
         Ok(Self {
             options,

@@ -21,10 +21,10 @@
 
 use std::f64::consts::TAU;
 
-use crate::contact::ImpactLaw;
 use crate::contact::pin_tangent::{GapJet, gap_jet_cs};
 use crate::dynamics::rigid::RigidModel;
-use crate::dynamics::scene::{Bearing, Joints, Scene};
+use crate::dynamics::model::laws::{BearingLaw, ContactLaw};
+use crate::dynamics::scene::{Joints, Scene};
 use crate::error::{Result, RvdynError};
 use crate::geometry::gap::small_sin_cos;
 
@@ -102,41 +102,6 @@ impl Dense {
     }
 }
 
-/// The radial force law of a bearing: force [N] and its derivative [N/m] at a radial
-/// penetration `r = |d| - c` [m].
-#[inline]
-fn bearing_law(b: &Bearing, r: f64) -> (f64, f64) {
-    if r <= 0.0 {
-        (0.0, 0.0)
-    } else {
-        (b.stiffness * r, b.stiffness)
-    }
-}
-
-/// `dV/dd` and `hess_d V` of a bearing at deflection `d` (see the module doc).
-#[inline]
-fn bearing_potential(b: &Bearing, d: [f64; 2]) -> ([f64; 2], [[f64; 2]; 2]) {
-    if b.clearance <= 0.0 {
-        let k = b.stiffness;
-        return ([k * d[0], k * d[1]], [[k, 0.0], [0.0, k]]);
-    }
-    let len = dot(d, d).sqrt();
-    let (f, fp) = bearing_law(b, len - b.clearance);
-    if f <= 0.0 && fp <= 0.0 {
-        return ([0.0; 2], [[0.0; 2]; 2]);
-    }
-    let n = [d[0] / len, d[1] / len];
-    let t = f / len;
-    let mut h = [[0.0; 2]; 2];
-    for a in 0..2 {
-        for c in 0..2 {
-            let id = if a == c { 1.0 } else { 0.0 };
-            h[a][c] = fp * n[a] * n[c] + t * (id - n[a] * n[c]);
-        }
-    }
-    ([f * n[0], f * n[1]], h)
-}
-
 /// What one evaluation found at every contact (fixed frame, SI).
 #[derive(Debug, Clone, Default)]
 pub struct ContactState {
@@ -183,10 +148,15 @@ pub enum Kind {
 /// The static reducer: geometry, laws and the map from unknowns to full coordinates.
 #[derive(Debug, Clone)]
 pub struct Statics {
+    /// The rigid model of the scene (geometry, laws; its parts).
     pub model: RigidModel,
+    /// Rigid or compliant joints.
     pub kind: Kind,
-    pub eccentric_bearing: Option<Bearing>,
-    pub crank_bearing: Option<Bearing>,
+    /// Law of the eccentric bearings (compliant joints).
+    pub eccentric_bearing: Option<BearingLaw>,
+    /// Law of the crank bearings (`None`: rigid).
+    pub crank_bearing: Option<BearingLaw>,
+    /// Number of cranks.
     pub cranks: usize,
     seats: Vec<[f64; 2]>,
     holes: Vec<[f64; 2]>,
@@ -233,7 +203,11 @@ impl Statics {
             Joints::Compliant {
                 eccentric_bearing,
                 crank_bearing,
-            } => (Kind::Compliant, Some(eccentric_bearing), crank_bearing),
+            } => (
+                Kind::Compliant,
+                Some(BearingLaw::Linear(eccentric_bearing)),
+                crank_bearing.map(BearingLaw::Linear),
+            ),
         };
         let n = model.cranks;
         let nd = model.discs.len();
@@ -633,7 +607,7 @@ impl Statics {
                 .as_ref()
                 .filter(|_| on(Family::CrankBearings))
             {
-                let (g, h) = bearing_potential(cb, dcr);
+                let (g, h) = cb.static_tangent(dcr);
                 // J_d: p -> I, th_c -> -perp(s).
                 let ps = perp(s);
                 let cols: [(usize, [f64; 2]); 3] = [
@@ -643,7 +617,7 @@ impl Statics {
                 ];
                 add_bearing(qf, kf, &cols, g, h);
                 if let Some(c) = cf.as_mut() {
-                    add_bearing_damping(c, &cols, bearing_damping(cb, dcr));
+                    add_bearing_damping(c, &cols, cb.damping_matrix(dcr));
                 }
                 kf.add(CARRIER, CARRIER, dot(g, s));
                 if let Some(st) = state.as_deref_mut() {
@@ -667,7 +641,7 @@ impl Statics {
                         x[dk] + arm[0] - p[0] - ecc[0],
                         x[dk + 1] + arm[1] - p[1] - ecc[1],
                     ];
-                    let (g, h) = bearing_potential(eb, d);
+                    let (g, h) = eb.static_tangent(d);
                     let pa = perp(arm);
                     let pe = perp(ecc);
                     let cols: [(usize, [f64; 2]); 6] = [
@@ -680,7 +654,7 @@ impl Statics {
                     ];
                     add_bearing(qf, kf, &cols, g, h);
                     if let Some(c) = cf.as_mut() {
-                        add_bearing_damping(c, &cols, bearing_damping(eb, d));
+                        add_bearing_damping(c, &cols, eb.damping_matrix(d));
                     }
                     kf.add(dk + 2, dk + 2, -dot(g, arm));
                     kf.add(ci + 2, ci + 2, dot(g, ecc));
@@ -853,7 +827,9 @@ impl Statics {
 /// Scratch space of [`Statics::eval`].
 #[derive(Debug, Clone)]
 pub struct Work {
+    /// Generalised forces in the full coordinates at the last evaluation.
     pub qf: Vec<f64>,
+    /// Tangent stiffness in the full coordinates at the last evaluation.
     pub kf: Dense,
     /// Tangent stiffness in the unknowns at the last equilibrium found.
     pub k_last: Dense,
@@ -861,6 +837,7 @@ pub struct Work {
 }
 
 impl Work {
+    /// Empty scratch space (sized on first use).
     pub fn new() -> Self {
         Self {
             qf: Vec::new(),
@@ -879,39 +856,14 @@ impl Default for Work {
 
 /// Elastic force [N] and its derivative [N/m] of a contact law at penetration `pen` [m].
 #[inline]
-pub fn elastic(law: &ImpactLaw, pen: f64) -> (f64, f64) {
-    if pen <= 0.0 {
-        return (0.0, 0.0);
-    }
-    let (f, df, _) = law.force_and_derivatives(pen, 0.0);
-    (f, df)
+pub fn elastic(law: &ContactLaw, pen: f64) -> (f64, f64) {
+    law.elastic_force_and_stiffness(pen)
 }
 
 /// Damping coefficient [N s/m] of a contact law at penetration `pen` [m] (at zero rate).
 #[inline]
-pub fn contact_damping(law: &ImpactLaw, pen: f64) -> f64 {
-    if pen <= 0.0 {
-        return 0.0;
-    }
-    law.force_and_derivatives(pen, 0.0).2
-}
-
-/// Damping matrix `dF/dd'` [N s/m] of a bearing at deflection `d` (at zero rate): `c I`
-/// without clearance, `c n n^T` beyond the clearance, 0 inside it.
-#[inline]
-fn bearing_damping(b: &Bearing, d: [f64; 2]) -> [[f64; 2]; 2] {
-    if b.clearance <= 0.0 {
-        return [[b.damping, 0.0], [0.0, b.damping]];
-    }
-    let len = dot(d, d).sqrt();
-    if len <= b.clearance {
-        return [[0.0; 2]; 2];
-    }
-    let n = [d[0] / len, d[1] / len];
-    [
-        [b.damping * n[0] * n[0], b.damping * n[0] * n[1]],
-        [b.damping * n[1] * n[0], b.damping * n[1] * n[1]],
-    ]
+pub fn contact_damping(law: &ContactLaw, pen: f64) -> f64 {
+    law.damping_coefficient(pen)
 }
 
 /// Add `J_d^T c J_d` for a bearing with deflection Jacobian columns `cols`.

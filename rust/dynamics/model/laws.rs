@@ -46,6 +46,34 @@ impl ContactLaw {
         }
     }
 
+    /// Elastic force [N] and its derivative, the static contact stiffness [N/m], at penetration
+    /// `x` [m] (both 0 for `x <= 0`): the contact's part of the tangent stiffness (quasi-static
+    /// analysis and modes).
+    #[inline]
+    pub fn elastic_force_and_stiffness(&self, x: f64) -> (f64, f64) {
+        if x <= 0.0 {
+            return (0.0, 0.0);
+        }
+        match self {
+            ContactLaw::Impact(l) => {
+                let (f, df, _) = l.force_and_derivatives(x, 0.0);
+                (f, df)
+            }
+        }
+    }
+
+    /// Damping coefficient `dF/dx'` [N s/m] at penetration `x` [m] and zero rate (0 for
+    /// `x <= 0`): the contact's part of the linearised damping matrix.
+    #[inline]
+    pub fn damping_coefficient(&self, x: f64) -> f64 {
+        if x <= 0.0 {
+            return 0.0;
+        }
+        match self {
+            ContactLaw::Impact(l) => l.force_and_derivatives(x, 0.0).2,
+        }
+    }
+
     /// A mesh with total backlash `backlash` [m] along the line of action at deflection
     /// `delta` [m] (positive on the drive flank) and rate `rate` [m/s]: the signed force [N]
     /// (negative on the coast flank), its signed elastic part, the penetration [m] (0 inside
@@ -91,6 +119,62 @@ impl BearingLaw {
     pub fn load(&self, d: [f64; 2], dd: [f64; 2]) -> BearingLoad {
         match self {
             BearingLaw::Linear(b) => linear_bearing(b, d, dd),
+        }
+    }
+}
+
+impl BearingLaw {
+    /// Static tangent of the bearing at deflection `d` [m] and zero rate: the gradient of its
+    /// potential `dV/dd` [N] (minus the force on the `+` body) and its Hessian `hess_d V`
+    /// [N/m]: `F n` and `F' n n^T + (F/|d|)(I - n n^T)` for the radial law `F(|d| - c)` along
+    /// `n = d/|d|`, `k d` and `k I` without clearance (docs/model.md, quasi-static analysis).
+    #[inline]
+    pub fn static_tangent(&self, d: [f64; 2]) -> ([f64; 2], [[f64; 2]; 2]) {
+        match self {
+            BearingLaw::Linear(b) => {
+                if b.clearance <= 0.0 {
+                    let k = b.stiffness;
+                    return ([k * d[0], k * d[1]], [[k, 0.0], [0.0, k]]);
+                }
+                let len = dot(d, d).sqrt();
+                let pen = len - b.clearance;
+                if pen <= 0.0 {
+                    return ([0.0; 2], [[0.0; 2]; 2]);
+                }
+                let (f, fp) = (b.stiffness * pen, b.stiffness);
+                let n = [d[0] / len, d[1] / len];
+                let t = f / len;
+                let mut h = [[0.0; 2]; 2];
+                for (a, row) in h.iter_mut().enumerate() {
+                    for (c, v) in row.iter_mut().enumerate() {
+                        let id = if a == c { 1.0 } else { 0.0 };
+                        *v = fp * n[a] * n[c] + t * (id - n[a] * n[c]);
+                    }
+                }
+                ([f * n[0], f * n[1]], h)
+            }
+        }
+    }
+
+    /// Damping matrix `dF/dd'` [N s/m] at deflection `d` and zero rate: `c I` without
+    /// clearance, `c n n^T` beyond it, 0 inside.
+    #[inline]
+    pub fn damping_matrix(&self, d: [f64; 2]) -> [[f64; 2]; 2] {
+        match self {
+            BearingLaw::Linear(b) => {
+                if b.clearance <= 0.0 {
+                    return [[b.damping, 0.0], [0.0, b.damping]];
+                }
+                let len = dot(d, d).sqrt();
+                if len <= b.clearance {
+                    return [[0.0; 2]; 2];
+                }
+                let n = [d[0] / len, d[1] / len];
+                [
+                    [b.damping * n[0] * n[0], b.damping * n[0] * n[1]],
+                    [b.damping * n[1] * n[0], b.damping * n[1] * n[1]],
+                ]
+            }
         }
     }
 }
