@@ -48,6 +48,7 @@ from ._types import GapResult, LineContact, OperatingPoint
 from .result import Result
 from .scene import Scene
 from .simulation import INTEGRATORS, Options, simulate, sweep
+from .analysis import ltca
 from .errors import (
     ConvergenceError,
     GeometryError,
@@ -66,6 +67,7 @@ __all__ = [
     "Options",
     "simulate",
     "sweep",
+    "ltca",
     "INTEGRATORS",
     "CycloidGeometry",
     "InvoluteStage",

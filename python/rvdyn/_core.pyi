@@ -432,3 +432,39 @@ def sweep(
 ) -> list[tuple[dict[str, NDArray[Any]], dict[str, Any]] | BaseException]:
     """Run many scenes in parallel; per scene (arrays, statistics) or the exception it raised.
     Ctrl-C stops every run (KeyboardInterrupt)."""
+
+# ---- quasi-static and modal analysis (rust/python/ltca.rs; wrapped by rvdyn.analysis) -------
+
+@final
+class LtcaSolver:
+    """The loaded tooth contact analysis of one scene; keeps its warm start and points."""
+
+    def __init__(self, scene: CompiledScene, tolerance: float) -> None: ...
+    @property
+    def mesh_period(self) -> float:
+        """Crank-angle period of the contact pattern [rad]."""
+    @property
+    def ratio(self) -> float:
+        """Transmission ratio input/output."""
+    @property
+    def face_width(self) -> float:
+        """Disc face width [m]."""
+    def sweep(self, torque: float, crank_angles: Sequence[float]) -> dict[str, NDArray[Any]]:
+        """Equilibria at crank_angles [rad] under torque [N m]: numpy arrays, crank angle first."""
+    def fea_loads(self) -> tuple[str, str]:
+        """Worst load case per disc over every point solved so far: (CSV, JSON)."""
+    def transmission_error(self, torque: float, light: float, points: int, start: float) -> dict[str, Any]:
+        """TE over one mesh period at +-torque and +-light [N m]."""
+    def twist_loop(self, rated: float, crank_angle: float, points: int) -> dict[str, Any]:
+        """Torque-twist loop with rigidity, lost motion and backlash."""
+
+def modes(scene: CompiledScene, torque: float, crank_angle: float) -> dict[str, Any]:
+    """Modes about the LTCA equilibrium at crank_angle [rad] under torque [N m]."""
+
+def excitation_orders(scene: CompiledScene) -> list[tuple[str, float]]:
+    """Excitation orders (name, multiple of the input rotation frequency)."""
+
+def campbell_crossings(
+    frequencies: Sequence[float], orders: Sequence[tuple[str, float]], speed_min: float, speed_max: float
+) -> list[dict[str, Any]]:
+    """Crossings of the orders with the natural frequencies [Hz] for input speeds [rad/s]."""
