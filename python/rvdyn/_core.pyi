@@ -40,6 +40,10 @@ __all__ = [
     "channels",
     "simulate",
     "sweep",
+    "LtcaSolver",
+    "modes",
+    "excitation_orders",
+    "campbell_crossings",
 ]
 
 __version__: str
@@ -439,7 +443,7 @@ def sweep(
 class LtcaSolver:
     """The loaded tooth contact analysis of one scene; keeps its warm start and points."""
 
-    def __init__(self, scene: CompiledScene, tolerance: float) -> None: ...
+    def __new__(cls, scene: CompiledScene, tolerance: float) -> LtcaSolver: ...
     @property
     def mesh_period(self) -> float:
         """Crank-angle period of the contact pattern [rad]."""

@@ -77,7 +77,8 @@ class LtcaResult:
     def __getattr__(self, name: str) -> np.ndarray:
         arrays = object.__getattribute__(self, "arrays")
         if name in arrays:
-            return arrays[name]
+            value: np.ndarray = arrays[name]
+            return value
         raise AttributeError(name)
 
     @property
@@ -149,7 +150,7 @@ class LtcaResult:
         ax.set_title(f"pin forces [kN], crank angle {math.degrees(self.arrays['crank_angle'][i]):.2f} deg, "
                      f"T = {self.torque / 1e3:.2f} kN m")
         ax.legend()
-        return fig  # type: ignore[return-value]
+        return fig
 
     def plot_contact_pressure(self, ax: Axes | None = None) -> Figure:
         """Largest Hertz peak pressure of each pin over the crank angles [MPa], per disc."""
@@ -188,7 +189,8 @@ class TransmissionError:
     def lost_motion(self) -> np.ndarray:
         """Difference of the reverse and forward TE at each crank angle [rad] (the lost motion
         at this torque)."""
-        return self.reverse - self.forward
+        diff: np.ndarray = self.reverse - self.forward
+        return diff
 
     def plot(self, ax: Axes | None = None) -> Figure:
         """TE in arcsec about its mean, both directions, loaded and unloaded."""
