@@ -73,8 +73,9 @@ impl GapJet {
 /// let g = CycloidGeometry::new(CycloidParams::paper()).unwrap();
 /// let psi: f64 = 0.3; // kinematic pose: every pin touches the unmodified disc
 /// let (c, a) = ([4.5e-3 * psi.cos(), 4.5e-3 * psi.sin()], -psi / 23.0);
-/// let pin = [0.15 * 0.5f64.cos(), 0.15 * 0.5f64.sin()];
-/// let jet = pin_gap_jet(&g, pin, 0.010, c, a, 0.5 - a).unwrap();
+/// let th = g.pin_angle(3); // the paper's pin 4
+/// let pin = [0.15 * th.cos(), 0.15 * th.sin()];
+/// let jet = pin_gap_jet(&g, pin, 0.010, c, a, th - a).unwrap();
 /// assert!(jet.gap.abs() < 1e-12);
 /// assert!((jet.grad[2] + jet.lever()).abs() < 1e-15);
 /// ```
