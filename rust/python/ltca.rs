@@ -21,11 +21,7 @@ pub(crate) struct LtcaSolver {
     points: Vec<LtcaPoint>,
 }
 
-fn f64_array<'py>(
-    py: Python<'py>,
-    v: Vec<f64>,
-    shape: Vec<usize>,
-) -> PyResult<Bound<'py, PyAny>> {
+fn f64_array<'py>(py: Python<'py>, v: Vec<f64>, shape: Vec<usize>) -> PyResult<Bound<'py, PyAny>> {
     Ok(v.into_pyarray(py).reshape(shape)?.into_any())
 }
 
@@ -108,8 +104,14 @@ impl LtcaSolver {
         d.set_item("period", te.period)?;
         d.set_item("forward", f64_array(py, te.forward, vec![n])?)?;
         d.set_item("reverse", f64_array(py, te.reverse, vec![n])?)?;
-        d.set_item("unloaded_forward", f64_array(py, te.unloaded_forward, vec![n])?)?;
-        d.set_item("unloaded_reverse", f64_array(py, te.unloaded_reverse, vec![n])?)?;
+        d.set_item(
+            "unloaded_forward",
+            f64_array(py, te.unloaded_forward, vec![n])?,
+        )?;
+        d.set_item(
+            "unloaded_reverse",
+            f64_array(py, te.unloaded_reverse, vec![n])?,
+        )?;
         Ok(d)
     }
 
@@ -154,7 +156,9 @@ fn pack<'py>(py: Python<'py>, pts: &[LtcaPoint]) -> PyResult<Bound<'py, PyDict>>
     let d = PyDict::new(py);
     let n = pts.len();
     let nd = pts.first().map_or(0, |p| p.pins.len());
-    let zp = pts.first().map_or(0, |p| p.pins.first().map_or(0, |r| r.len()));
+    let zp = pts
+        .first()
+        .map_or(0, |p| p.pins.first().map_or(0, |r| r.len()));
     let ncr = pts.first().map_or(0, |p| p.mesh_force.len());
     let scalar = |f: &dyn Fn(&LtcaPoint) -> f64| pts.iter().map(f).collect::<Vec<f64>>();
     for (name, v) in [
@@ -282,7 +286,8 @@ fn campbell_crossings<'py>(
     speed_min: f64,
     speed_max: f64,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let c = crate::analysis::modal::campbell_crossings(&frequencies, &orders, speed_min, speed_max)?;
+    let c =
+        crate::analysis::modal::campbell_crossings(&frequencies, &orders, speed_min, speed_max)?;
     c.into_iter()
         .map(|x| {
             let d = PyDict::new(py);

@@ -22,8 +22,8 @@
 use std::f64::consts::TAU;
 
 use crate::contact::pin_tangent::{GapJet, gap_jet_cs};
-use crate::dynamics::rigid::RigidModel;
 use crate::dynamics::model::laws::{BearingLaw, ContactLaw};
+use crate::dynamics::rigid::RigidModel;
 use crate::dynamics::scene::{Joints, Scene};
 use crate::error::{Result, RvdynError};
 use crate::geometry::gap::small_sin_cos;

@@ -326,3 +326,67 @@ fn figures() {
         }
     }
 }
+
+/// Errors of the benchmarked results against converged references (printed; run with
+/// `--ignored --nocapture`): the bench scene (compliant bearings, Palmgren line law, rated
+/// torque) at 360 crank angles per period against 2880, and at the default Newton tolerance
+/// against 1e-14.
+#[test]
+#[ignore]
+fn bench_reference_errors() {
+    let mut s = Scene::paper("rated").unwrap();
+    s.joints = default_joints();
+    s.contact.pin = ContactLawSpec::Palmgren {
+        max_damping: 1e5,
+        damping_depth: 1e-5,
+    };
+    let mut ltca = Ltca::new(&s).unwrap();
+    let period = ltca.mesh_period();
+    let grid = |n: usize| -> Vec<f64> { (0..n).map(|i| period * i as f64 / n as f64).collect() };
+    let coarse = ltca.sweep(rated(), &grid(360)).unwrap();
+    ltca.reset();
+    let fine = ltca.sweep(rated(), &grid(2880)).unwrap();
+    let te =
+        |p: &[LtcaPoint]| peak_to_peak(&p.iter().map(|x| x.transmission_error).collect::<Vec<_>>());
+    let peak = |p: &[LtcaPoint]| p.iter().map(|x| x.peak_pin_force()).fold(0.0, f64::max);
+    println!(
+        "360 vs 2880 angles: TE p-p {:.6e} vs {:.6e} rad (rel {:.2e}); peak pin force {:.3} vs {:.3} N (rel {:.2e})",
+        te(&coarse),
+        te(&fine),
+        te(&coarse) / te(&fine) - 1.0,
+        peak(&coarse),
+        peak(&fine),
+        peak(&coarse) / peak(&fine) - 1.0
+    );
+    let mut tight = Ltca::with_options(
+        &s,
+        NewtonOptions {
+            tolerance: 1e-14,
+            ..NewtonOptions::default()
+        },
+    )
+    .unwrap();
+    let t = tight.sweep(rated(), &grid(360)).unwrap();
+    let worst = coarse
+        .iter()
+        .zip(&t)
+        .map(|(a, b)| (a.output_angle - b.output_angle).abs())
+        .fold(0.0, f64::max);
+    let worst_f = coarse
+        .iter()
+        .zip(&t)
+        .map(|(a, b)| (a.peak_pin_force() - b.peak_pin_force()).abs())
+        .fold(0.0, f64::max);
+    println!(
+        "tolerance 1e-12 vs 1e-14: output angle {worst:.2e} rad, peak pin force {worst_f:.2e} N"
+    );
+    let lp = ltca.twist_loop(rated(), 0.0, 200).unwrap();
+    let lp2 = ltca.twist_loop(rated(), 0.0, 801).unwrap();
+    println!(
+        "loop 200 vs 801 points: rigidity {:.6} vs {:.6} N m/arcmin, lost motion {:.6} vs {:.6} arcmin",
+        lp.rigidity * ARCMIN,
+        lp2.rigidity * ARCMIN,
+        lp.lost_motion / ARCMIN,
+        lp2.lost_motion / ARCMIN
+    );
+}
