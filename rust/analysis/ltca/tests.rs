@@ -390,3 +390,57 @@ fn bench_reference_errors() {
         lp2.lost_motion / ARCMIN
     );
 }
+
+/// Thread CPU time of the benchmarked workloads (printed; run with `--release --ignored
+/// --nocapture`): on a shared machine the wall-clock medians of `benches/ltca.rs` include the
+/// waits for a core; the CPU time of the measuring thread does not (Linux only).
+#[test]
+#[ignore]
+fn cpu_time_report() {
+    fn cpu() -> f64 {
+        let s = std::fs::read_to_string("/proc/thread-self/stat").unwrap_or_default();
+        let rest = s.rfind(')').map_or("", |i| &s[i + 2..]);
+        let f: Vec<&str> = rest.split_whitespace().collect();
+        // utime and stime are fields 14 and 15 of stat, the 12th and 13th after the name.
+        let field = |i: usize| f.get(i).and_then(|x| x.parse::<f64>().ok()).unwrap_or(0.0);
+        (field(11) + field(12)) / 100.0
+    }
+    let mut s = Scene::paper("rated").unwrap();
+    s.joints = default_joints();
+    s.contact.pin = ContactLawSpec::Palmgren {
+        max_damping: 1e5,
+        damping_depth: 1e-5,
+    };
+    let mut ltca = Ltca::new(&s).unwrap();
+    let period = ltca.mesh_period();
+    let angles: Vec<f64> = (0..360).map(|i| period * i as f64 / 360.0).collect();
+    let reps = 100;
+    let t0 = cpu();
+    for _ in 0..reps {
+        ltca.reset();
+        ltca.sweep(rated(), &angles).unwrap();
+    }
+    let sweep = (cpu() - t0) / reps as f64;
+    let t0 = cpu();
+    for _ in 0..reps {
+        ltca.reset();
+        for &a in &angles {
+            ltca.solve_unknowns(rated(), a).unwrap();
+        }
+    }
+    let bare = (cpu() - t0) / reps as f64;
+    let t0 = cpu();
+    for _ in 0..reps {
+        ltca.twist_loop(rated(), 0.0, 200).unwrap();
+    }
+    let lp = (cpu() - t0) / reps as f64;
+    println!(
+        "CPU: 360 angles with full reports {:.2} ms ({:.1} us/angle); equilibria only {:.2} ms \
+         ({:.1} us/angle); 200-point loop {:.2} ms",
+        sweep * 1e3,
+        sweep / 360.0 * 1e6,
+        bare * 1e3,
+        bare / 360.0 * 1e6,
+        lp * 1e3
+    );
+}
