@@ -28,9 +28,7 @@ impl Scene {
             }
             crate::geometry::CycloidGeometry::check(self.disc_params(k))?;
         }
-        if self.cranks < 1 {
-            return err("cranks must be at least 1".into());
-        }
+        crate::geometry::involute::check_crank_count(self.cranks)?;
         if let Some(s) = &self.stage1 {
             s.validate()?;
             if s.planets != self.cranks {
@@ -63,8 +61,12 @@ impl Scene {
         {
             return err("pin_errors must be finite".into());
         }
-        if !(self.density.is_finite() && self.density > 0.0) {
-            return err(format!("density must be > 0 kg/m^3, got {}", self.density));
+        crate::geometry::cycloid::check_pin_radii(
+            self.cycloid.pin_radius,
+            &self.pin_errors.radius,
+        )?;
+        if let Err(e) = crate::geometry::mass::require_density(self.density) {
+            return err(format!("scene density: {e}"));
         }
         let i = &self.inertias;
         for (n, mp) in [

@@ -92,12 +92,12 @@ pub struct CompliantModel {
     /// Geometry, laws, inertias, drive and load (shared with the rigid model).
     pub(crate) parts: Parts,
     /// Law of the needle bearing between each eccentric and its disc hole.
-    pub eccentric_bearing: BearingLaw,
+    pub(crate) eccentric_bearing: BearingLaw,
     /// `None`: rigid crank bearings, the crank centres stay in their seats on the carrier
     /// (their mass then turns with the carrier: `n m_cr r_cr^2` joins its inertia).
-    pub crank_bearing: Option<BearingLaw>,
+    pub(crate) crank_bearing: Option<BearingLaw>,
     /// Number of cranks.
-    pub cranks: usize,
+    pub(crate) cranks: usize,
     /// `(cos gamma_i, sin gamma_i)` of each crank seat.
     seats: Vec<[f64; 2]>,
     /// Disc hole centres `h_ik` in the disc frame, at `i * discs + k` [m].
@@ -105,11 +105,11 @@ pub struct CompliantModel {
     /// `(sin, cos)` of the pressure angle: `w_i = sin u_i + cos (z x u_i)`.
     pressure: [f64; 2],
     /// Diagonal mass of every full coordinate [kg or kg m^2].
-    pub mass: Vec<f64>,
+    pub(crate) mass: Vec<f64>,
     /// Free coordinates (indices into the full vector).
-    pub free: Vec<usize>,
+    pub(crate) free: Vec<usize>,
     /// Prescribed coordinates (the sun, or every crank rotation without a first stage).
-    pub prescribed: Vec<usize>,
+    pub(crate) prescribed: Vec<usize>,
     /// Coordinates the input torque acts on (shared equally).
     input: Vec<usize>,
     /// Lever per free coordinate [m per unit].
