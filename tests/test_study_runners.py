@@ -112,3 +112,31 @@ def test_a_dead_worker_is_recorded_not_dropped(monkeypatch: pytest.MonkeyPatch, 
         t2 = rvdyn.study(SCENE, kernel, tols, runner=ex, retry_failed=True, **args)
     assert list(t2["sample"]) == list(range(12)) and (t2["error"] == "").all()
     assert (t2["threads"] == 1.0).all()  # workers ran single-threaded
+
+
+def dask_dying_metric(scene: rvdyn.Scene) -> dict[str, float]:
+    """Kills its worker once: the first task to find the file named by $RVDYN_TEST_DIE removes
+    it and dies."""
+    marker = os.environ.get("RVDYN_TEST_DIE", "")
+    if marker:
+        try:
+            os.remove(marker)
+        except FileNotFoundError:
+            pass
+        else:
+            os._exit(3)
+    return {"y": scene["cycloid.d_rrp"]}
+
+
+@pytest.mark.filterwarnings("ignore:Creating scratch directories is taking:UserWarning")
+def test_dask_reruns_the_task_of_a_dead_worker(monkeypatch: pytest.MonkeyPatch, tmp_path: os.PathLike[str]) -> None:
+    distributed = pytest.importorskip("distributed")
+    marker = os.path.join(tmp_path, "die")
+    open(marker, "w").close()
+    monkeypatch.setenv("RVDYN_TEST_DIE", marker)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=50) as cluster, distributed.Client(cluster) as client:
+        t = rvdyn.study(SCENE, FunctionKernel(dask_dying_metric, ("y",)), [Tolerance("cycloid.d_rrp", tol=1e-5)],
+                        samples=6, seed=0, runner=client)
+    assert not os.path.exists(marker)  # a worker died ...
+    assert list(t["sample"]) == list(range(6)) and (t["error"] == "").all()  # ... and its task ran again
