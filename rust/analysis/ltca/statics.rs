@@ -1041,8 +1041,10 @@ mod tests {
     /// approaches of tens of um; poses with a contact within 1 um of touching are skipped).
     /// One-sided differences of a Hertz-type law are wrong by about `h F'' / (2 F')` =
     /// `h / (4 x)` (relative) at an approach `x` (measured: 2e-5): 1e-4 of the largest entry
-    /// (N/m after scaling angles by rp) is asserted. The geometric term `F hess g` alone is
-    /// ~1e-3 of it here, so a wrong geometric stiffness fails this test.
+    /// (N/m after scaling angles by rp) is asserted. At this tolerance the test ties the
+    /// analytic tangent to the model's force evaluation but cannot see the geometric term
+    /// `F hess g` (a flipped sign of it still passes); the central-difference test below, at
+    /// 1e-6 on the same forces, does fail for that mutation.
     #[test]
     fn tangent_matches_the_models_finite_difference_tangent() {
         use crate::dynamics::model::ReducerModel;
