@@ -1,4 +1,5 @@
-"""Property-based tests of the public geometry, contact and kinematics API (hypothesis).
+"""Property-based tests of the public API (hypothesis): geometry, contact, kinematics, and
+scenes, short simulations and their results.
 
 Properties, for arguments drawn from physical, extreme (subnormal, 1e308, 2**64) and invalid
 (NaN, inf, negative) values:
@@ -79,7 +80,8 @@ def _report_counts(request):
 def _finite(value: Any) -> bool:
     """True if every number in a returned value (float, array, tuple, dict, GapResult) is
     finite."""
-    if isinstance(value, (bool, int, np.integer, rvdyn.CycloidGeometry, rvdyn.InvoluteStage)):
+    if value is None or isinstance(value, (str, bool, int, np.integer, rvdyn.CycloidGeometry,
+                                           rvdyn.InvoluteStage, rvdyn.Scene, rvdyn.Result)):
         return True  # the numbers of built objects are checked through their properties
     if isinstance(value, (float, np.floating)):
         return math.isfinite(value)
@@ -349,6 +351,57 @@ def test_wrong_types(value, which):
         lambda: rvdyn.transmission_ratio(value, 42, 24),
     ]
     check("wrong types", calls[which], type_error=True)
+
+
+# --- scenes, simulate and results -----------------------------------------------------------
+
+def _fields(physical: bool) -> dict[str, st.SearchStrategy[Any]]:
+    def pick(phys: st.SearchStrategy[Any], other: st.SearchStrategy[Any]) -> st.SearchStrategy[Any]:
+        return phys if physical else st.one_of(phys, other)
+
+    return {
+        "cycloid.d_rp": pick(st.floats(-2e-4, 0.0), any_real),
+        "cycloid.d_rrp": pick(st.floats(0.0, 5e-5), any_real),
+        "cycloid.pin_radius": pick(st.floats(8e-3, 1.2e-2), any_real),
+        "density": pick(st.floats(2e3, 2e4), any_real),
+        "cranks": pick(st.just(3), any_count),
+        "drive.speed": pick(st.floats(10.0, 200.0), any_real),
+        "pin_errors.radius": pick(st.lists(st.floats(-2e-5, 2e-5), min_size=24, max_size=24),
+                                  st.lists(any_real, min_size=24, max_size=24)),
+    }
+
+
+scene_changes = st.booleans().flatmap(
+    lambda physical: st.fixed_dictionaries({}, optional=_fields(physical)))
+
+run_options = st.booleans().flatmap(lambda physical: st.fixed_dictionaries({}, optional={
+    "dt": st.floats(1e-5, 1e-4) if physical else st.one_of(st.floats(1e-6, 1e-3), any_real),
+    "max_samples": st.integers(2, 2000) if physical else any_count,
+    "record_interval": (st.floats(1e-5, 1e-3) if physical
+                        else st.one_of(st.floats(1e-5, 1e-3), any_real)),
+}))
+
+
+@settings(max_examples=max(10, EXAMPLES // 5), deadline=None, derandomize=True, database=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(st.sampled_from(["idle", "paper", "rated"]), scene_changes, run_options,
+       st.sampled_from(["rk4", "dopri5", "generalized-alpha"]),
+       st.one_of(st.floats(0.0, 0.002), any_real))
+def test_scenes_simulate_and_results(load, changes, options, integrator, when):
+    scene = check("Scene.paper/replace", lambda: rvdyn.Scene.paper(load, **changes))
+    if scene is None:
+        return
+    check("Scene.model_info", scene.model_info)
+    # Short runs (2 ms): the property is about bad input, not about long dynamics.
+    r = check("simulate", lambda: rvdyn.simulate(scene, 0.002, integrator, **options))
+    if r is None:
+        return
+    for name in r.channels:
+        check("Result channels", lambda: getattr(r, name))
+    check("Result.largest_moment_pin", lambda: r.largest_moment_pin(when))
+    check("Result.disc_path_radius", lambda: r.disc_path_radius(when))
+    check("Result.loaded_pin_stats", lambda: r.loaded_pin_stats())
+    check("Result.energy_balance", r.energy_balance)
 
 
 # --- the dangerous cases, in child processes ------------------------------------------------

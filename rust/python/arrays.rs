@@ -23,7 +23,7 @@ use pyo3::types::PyFloat;
 pub(crate) const MAX_NDIM: usize = 32;
 
 /// The first `limit` characters of `repr(value)` (for messages about unreadable arguments).
-fn short_repr(value: &Bound<'_, PyAny>, limit: usize) -> String {
+pub(crate) fn short_repr(value: &Bound<'_, PyAny>, limit: usize) -> String {
     let text = value
         .repr()
         .map(|r| r.to_string())

@@ -186,10 +186,10 @@ impl Ltca {
     pub fn with_options(scene: &Scene, options: NewtonOptions) -> Result<Self> {
         require_finite("tolerance", options.tolerance)?;
         let statics = Statics::new(scene)?;
-        let law = statics.model.pin_law;
+        let law = statics.pin_law;
         let (f, _) = statics::elastic(&law, 1e-5);
         let mut k_ref = f / 1e-5;
-        if let Some(b) = statics.eccentric_bearing {
+        if let Some(b) = &statics.eccentric_bearing {
             // The bearing's stiffness at a 1 mm deflection (beyond any clearance it has).
             k_ref = k_ref.max(b.static_tangent([1e-3, 0.0]).1[0][0]);
         }

@@ -21,6 +21,8 @@
 
 use std::f64::consts::TAU;
 
+use crate::contact::ImpactLaw;
+use crate::contact::law::{MeshLaw, PinLaw};
 use crate::contact::pin_tangent::{GapJet, gap_jet_cs};
 use crate::dynamics::model::laws::{BearingLaw, ContactLaw};
 use crate::dynamics::rigid::RigidModel;
@@ -158,6 +160,10 @@ pub struct Statics {
     pub crank_bearing: Option<BearingLaw>,
     /// Number of cranks.
     pub cranks: usize,
+    /// The pin law (IMPACT or Palmgren).
+    pub pin_law: ImpactLaw,
+    /// The mesh law (IMPACT; unused without a first stage).
+    pub mesh_law: ImpactLaw,
     seats: Vec<[f64; 2]>,
     holes: Vec<[f64; 2]>,
     /// `(sin, cos)` of the pressure angle.
@@ -205,9 +211,34 @@ impl Statics {
                 crank_bearing,
             } => (
                 Kind::Compliant,
-                Some(BearingLaw::Linear(eccentric_bearing)),
-                crank_bearing.map(BearingLaw::Linear),
+                Some(BearingLaw::new(&eccentric_bearing)?),
+                crank_bearing.as_ref().map(BearingLaw::new).transpose()?,
             ),
+        };
+        // The tangent is analytic for the IMPACT-type laws (the paper's and Palmgren's); the
+        // physical model's line law and ISO mesh stiffness are not linearised yet.
+        let pin_law = match &model.pin_law {
+            PinLaw::Impact(l) => *l,
+            _ => {
+                return Err(RvdynError::Scene(
+                    "the quasi-static analysis supports the IMPACT and Palmgren pin laws so far; \
+                     the line-contact law is not linearised yet: set contact.pin to an \
+                     \"impact\" or \"palmgren\" law"
+                        .into(),
+                ));
+            }
+        };
+        let mesh_law = match model.mesh.as_ref().map(|m| &m.law) {
+            None => pin_law,
+            Some(MeshLaw::Impact(l)) => *l,
+            Some(_) => {
+                return Err(RvdynError::Scene(
+                    "the quasi-static analysis supports the IMPACT mesh law so far; the ISO \
+                     6336 mesh stiffness is not linearised yet: set contact.mesh to an \
+                     \"impact\" law"
+                        .into(),
+                ));
+            }
         };
         let n = model.cranks;
         let nd = model.discs.len();
@@ -261,6 +292,8 @@ impl Statics {
             eccentric_bearing,
             crank_bearing,
             cranks: n,
+            pin_law,
+            mesh_law,
             seats,
             holes,
             pressure,
@@ -519,14 +552,14 @@ impl Statics {
                 let pen = -jet.gap;
                 self.max_penetration = self.max_penetration.max(pen);
                 let (f, fp) = if on(Family::Pins(k)) {
-                    elastic(&m.pin_law, pen)
+                    elastic(&self.pin_law, pen)
                 } else {
                     (0.0, 0.0)
                 };
                 if let Some(c) = cf.as_mut()
                     && on(Family::Pins(k))
                 {
-                    c.outer(&idx, &jet.grad, contact_damping(&m.pin_law, pen));
+                    c.outer(&idx, &jet.grad, contact_damping(&self.pin_law, pen));
                 }
                 if f > 0.0 || fp > 0.0 {
                     for a in 0..3 {
@@ -556,49 +589,57 @@ impl Statics {
             let p = [x[ci], x[ci + 1]];
             let dcr = [p[0] - s[0], p[1] - s[1]];
             let alpha = x[ci + 2];
-            // Sun/planet mesh i.
+            // Sun/planet mesh i, two flanks with their own lines of action
+            // w = sin(pa) u +- cos(pa) z x u (the compliant model's mesh): the flank
+            // `sigma` (+1 drive, -1 coast) penetrates by `sigma rot - d . w - b/2`.
             if let Some(mm) = &m.mesh {
                 let [sp, cp] = self.pressure;
                 let zu = perp(u);
-                let w = [sp * u[0] + cp * zu[0], sp * u[1] + cp * zu[1]];
-                let zw = perp(w);
                 let (rbs, rbp) = (mm.sun_base_radius, mm.planet_base_radius);
-                let delta = rbs * (x[SUN] - thc) + rbp * (alpha - thc) - dot(dcr, w);
+                let rot = rbs * (x[SUN] - thc) + rbp * (alpha - thc);
                 let half = 0.5 * mm.backlash;
-                let sigma = if delta >= 0.0 { 1.0 } else { -1.0 };
-                let pen = sigma * delta - half;
-                self.max_penetration = self.max_penetration.max(pen);
-                let (f, fp) = if on(Family::Mesh) {
-                    elastic(&mm.law, pen)
-                } else {
-                    (0.0, 0.0)
-                };
                 let idx = [SUN, CARRIER, ci + 2, ci, ci + 1];
-                let grad = [
-                    rbs,
-                    -rbs - rbp + dot(perp(s), w) - dot(dcr, zw),
-                    rbp,
-                    -w[0],
-                    -w[1],
-                ];
-                if let Some(c) = cf.as_mut()
-                    && on(Family::Mesh)
-                {
-                    c.outer(&idx, &grad, contact_damping(&mm.law, pen));
-                }
-                if f > 0.0 || fp > 0.0 {
-                    for a in 0..5 {
-                        qf[idx[a]] -= sigma * f * grad[a];
+                let mut f_report = 0.0;
+                for sigma in [1.0, -1.0] {
+                    let w = [
+                        sp * u[0] + sigma * cp * zu[0],
+                        sp * u[1] + sigma * cp * zu[1],
+                    ];
+                    let zw = perp(w);
+                    let pen = sigma * rot - dot(dcr, w) - half;
+                    self.max_penetration = self.max_penetration.max(pen);
+                    let (f, fp) = if on(Family::Mesh) {
+                        elastic(&self.mesh_law, pen)
+                    } else {
+                        (0.0, 0.0)
+                    };
+                    let grad = [
+                        sigma * rbs,
+                        -sigma * (rbs + rbp) + dot(perp(s), w) - dot(dcr, zw),
+                        sigma * rbp,
+                        -w[0],
+                        -w[1],
+                    ];
+                    if let Some(c) = cf.as_mut()
+                        && on(Family::Mesh)
+                    {
+                        c.outer(&idx, &grad, contact_damping(&self.mesh_law, pen));
                     }
-                    kf.outer(&idx, &grad, fp);
-                    let sf = sigma * f;
-                    kf.add(CARRIER, CARRIER, sf * dot(p, w));
-                    kf.sym(CARRIER, ci, -sf * zw[0]);
-                    kf.sym(CARRIER, ci + 1, -sf * zw[1]);
+                    if f > 0.0 || fp > 0.0 {
+                        for a in 0..5 {
+                            qf[idx[a]] -= f * grad[a];
+                        }
+                        kf.outer(&idx, &grad, fp);
+                        kf.add(CARRIER, CARRIER, f * dot(p, w));
+                        kf.sym(CARRIER, ci, -f * zw[0]);
+                        kf.sym(CARRIER, ci + 1, -f * zw[1]);
+                    }
+                    f_report += sigma * f;
                 }
                 if let Some(st) = state.as_deref_mut() {
-                    st.mesh_force.push(sigma * f);
-                    st.mesh_deflection.push(delta);
+                    st.mesh_force.push(f_report);
+                    st.mesh_deflection
+                        .push(rot - dot(dcr, [sp * u[0] + cp * zu[0], sp * u[1] + cp * zu[1]]));
                 }
             }
             // Crank bearing: d = p - s(th_c).
@@ -854,16 +895,17 @@ impl Default for Work {
     }
 }
 
-/// Elastic force [N] and its derivative [N/m] of a contact law at penetration `pen` [m].
+/// Elastic force [N] and its derivative [N/m] of an IMPACT contact law at penetration `pen`
+/// [m] (the laws [`Statics::new`] accepts).
 #[inline]
-pub fn elastic(law: &ContactLaw, pen: f64) -> (f64, f64) {
-    law.elastic_force_and_stiffness(pen)
+pub fn elastic(law: &ImpactLaw, pen: f64) -> (f64, f64) {
+    ContactLaw::Impact(*law).elastic_force_and_stiffness(pen)
 }
 
-/// Damping coefficient [N s/m] of a contact law at penetration `pen` [m] (at zero rate).
+/// Damping coefficient [N s/m] of an IMPACT law at penetration `pen` [m] (at zero rate).
 #[inline]
-pub fn contact_damping(law: &ContactLaw, pen: f64) -> f64 {
-    law.damping_coefficient(pen)
+pub fn contact_damping(law: &ImpactLaw, pen: f64) -> f64 {
+    ContactLaw::Impact(*law).damping_coefficient(pen)
 }
 
 /// Add `J_d^T c J_d` for a bearing with deflection Jacobian columns `cols`.

@@ -115,9 +115,8 @@ fn balances_close_and_zero_load_has_zero_te() {
 /// crank angle negated (pins j -> zp - j; the second disc's offset changes by a lobe pitch,
 /// which the profile cannot tell; the planet seats map onto each other). So the equilibrium at
 /// (psi, -T) is the mirror image of that at (-psi, T): pin forces of mirrored pins equal, TE
-/// opposite. Symmetric modifications (d_rp, d_rrp) keep the symmetry. (With compliant crank
-/// bearings the compliant model's mesh line of action keeps its radial component on the
-/// reverse flank, which breaks the mirror: the crank bearings are rigid here.)
+/// opposite. Symmetric modifications (d_rp, d_rrp) keep the symmetry. (Rigid crank bearings
+/// here; the two-flank mesh of the compliant model keeps the symmetry with compliant ones too.)
 #[test]
 fn reversing_the_torque_mirrors_the_result() {
     let mut s = Scene::paper("rated").unwrap();
