@@ -15,6 +15,8 @@ transmission_ratio, body_speeds, operating_point
     Kinematics and the operating point.
 Scene, simulate, sweep, Result
     Reducer scenes, dynamic runs (one or many in parallel) and their recorded results.
+order_spectrum, excitation_orders
+    Order spectrum of a recorded channel, labelled with the reducer's excitation orders.
 rvdyn.plotting
     Matplotlib figures (geometry, contact stiffness).
 """
@@ -43,6 +45,7 @@ from ._core import (
     transmission_ratio,
 )
 from ._types import GapResult, LineContact, OperatingPoint
+from .analysis.spectrum import excitation_orders, order_spectrum
 from .result import Result
 from .scene import Scene
 from .simulation import INTEGRATORS, simulate, sweep
@@ -64,6 +67,8 @@ __all__ = [
     "simulate",
     "sweep",
     "INTEGRATORS",
+    "order_spectrum",
+    "excitation_orders",
     "CycloidGeometry",
     "InvoluteStage",
     "GapResult",

@@ -12,6 +12,7 @@ mod contact;
 mod errors;
 mod geometry;
 mod kinematics;
+mod modal;
 mod simulate;
 
 use numpy::ndarray::{ArrayD, IxDyn};
@@ -212,5 +213,6 @@ fn rvdyn_core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     contact::register(m)?;
     kinematics::register(m)?;
     simulate::register(m)?;
+    modal::register(m)?;
     Ok(())
 }
