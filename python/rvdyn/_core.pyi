@@ -40,6 +40,8 @@ __all__ = [
     "channels",
     "simulate",
     "sweep",
+    "excitation_orders",
+    "campbell_crossings",
 ]
 
 __version__: str
@@ -432,3 +434,15 @@ def sweep(
 ) -> list[tuple[dict[str, NDArray[Any]], dict[str, Any]] | BaseException]:
     """Run many scenes in parallel; per scene (arrays, statistics) or the exception it raised.
     Ctrl-C stops every run (KeyboardInterrupt)."""
+
+# ---- vibration analyses (rust/python/modal.rs) ------------------------------------------------
+
+def excitation_orders(scene_json: str, harmonics: int = 3) -> list[tuple[str, int, float, str]]:
+    """Excitation orders of a scene as (name, harmonic, order, label), by increasing order."""
+
+def campbell_crossings(
+    speeds: list[float],
+    frequencies: list[list[float]],
+    orders: list[tuple[str, int, float, str]],
+) -> list[tuple[float, float, int, int]]:
+    """Order-line crossings: (speed [rad/s], frequency [Hz], order index, mode index)."""

@@ -12,6 +12,7 @@ mod contact;
 mod errors;
 mod geometry;
 mod kinematics;
+mod modal;
 mod scene;
 mod simulate;
 
@@ -214,5 +215,6 @@ fn rvdyn_core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     kinematics::register(m)?;
     scene::register(m)?;
     simulate::register(m)?;
+    modal::register(m)?;
     Ok(())
 }
