@@ -100,6 +100,7 @@ def test_rated_paper_run_ripple_is_labelled_pin_pass() -> None:
     # harmonics add to the peak-to-peak).
     assert math.degrees(spec.peaks[0].amplitude) == pytest.approx(0.29, rel=0.1)
     assert all(p.label != "sun mesh" for p in spec.peaks)
+    assert res.spectrum("carrier_speed", (0.2, 1.0)).peaks[0].label == "pin pass"
     # Order tracking gives the same orders.
     tracked = rvdyn.order_spectrum(res, "carrier_speed", window=(0.2, 1.0), domain="angle")
     assert [p.label for p in tracked.peaks[:3]] == labels
