@@ -17,6 +17,8 @@ Scene, Options, simulate, sweep, Result
     Reducer scenes, run options, dynamic runs (one or many in parallel) and their recorded
     results. The theory is in the repository's ``docs/model.md``, the user guide in
     ``docs/guide.md``.
+order_spectrum, excitation_orders
+    Order spectrum of a recorded channel, labelled with the reducer's excitation orders.
 rvdyn.plotting
     Matplotlib figures (geometry, contact stiffness).
 """
@@ -45,6 +47,7 @@ from ._core import (
     transmission_ratio,
 )
 from ._types import GapResult, LineContact, OperatingPoint
+from .analysis.spectrum import excitation_orders, order_spectrum
 from .result import Result
 from .scene import Scene
 from .simulation import INTEGRATORS, Options, simulate, sweep
@@ -69,6 +72,8 @@ __all__ = [
     "sweep",
     "ltca",
     "INTEGRATORS",
+    "order_spectrum",
+    "excitation_orders",
     "CycloidGeometry",
     "InvoluteStage",
     "GapResult",

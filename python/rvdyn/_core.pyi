@@ -41,7 +41,6 @@ __all__ = [
     "simulate",
     "sweep",
     "LtcaSolver",
-    "modes",
     "excitation_orders",
     "campbell_crossings",
 ]
@@ -437,7 +436,7 @@ def sweep(
     """Run many scenes in parallel; per scene (arrays, statistics) or the exception it raised.
     Ctrl-C stops every run (KeyboardInterrupt)."""
 
-# ---- quasi-static and modal analysis (rust/python/ltca.rs; wrapped by rvdyn.analysis) -------
+# ---- quasi-static analysis (rust/python/ltca.rs; wrapped by rvdyn.analysis) -----------------
 
 @final
 class LtcaSolver:
@@ -462,13 +461,14 @@ class LtcaSolver:
     def twist_loop(self, rated: float, crank_angle: float, points: int) -> dict[str, Any]:
         """Torque-twist loop with rigidity, lost motion and backlash."""
 
-def modes(scene: CompiledScene, torque: float, crank_angle: float) -> dict[str, Any]:
-    """Modes about the LTCA equilibrium at crank_angle [rad] under torque [N m]."""
+# ---- vibration analyses (rust/python/modal.rs) ------------------------------------------------
 
-def excitation_orders(scene: CompiledScene) -> list[tuple[str, float]]:
-    """Excitation orders (name, multiple of the input rotation frequency)."""
+def excitation_orders(scene_json: str, harmonics: int = 3) -> list[tuple[str, int, float, str]]:
+    """Excitation orders of a scene as (name, harmonic, order, label), by increasing order."""
 
 def campbell_crossings(
-    frequencies: Sequence[float], orders: Sequence[tuple[str, float]], speed_min: float, speed_max: float
-) -> list[dict[str, Any]]:
-    """Crossings of the orders with the natural frequencies [Hz] for input speeds [rad/s]."""
+    speeds: list[float],
+    frequencies: list[list[float]],
+    orders: list[tuple[str, int, float, str]],
+) -> list[tuple[float, float, int, int]]:
+    """Order-line crossings: (speed [rad/s], frequency [Hz], order index, mode index)."""

@@ -3,5 +3,6 @@
 pub mod load_sharing;
 pub mod ltca;
 pub mod modal;
+pub mod orders;
 
 pub use load_sharing::{classical_levers, classical_pin_forces};

@@ -1,7 +1,8 @@
-"""Quasi-static analysis: loaded tooth contact analysis (LTCA), transmission error in both
-drive directions, the torque-twist loop (rigidity, lost motion, backlash) and contact loads for
-FEA. The equilibria are computed by the Rust core (``rvdyn._core``); docs/model.md,
-"Quasi-static analysis", gives the formulation and conventions.
+"""Analyses of scenes and results: loaded tooth contact analysis (LTCA), transmission error in
+both drive directions, the torque-twist loop (rigidity, lost motion, backlash) and contact loads
+for FEA; order spectra of dynamic runs (:mod:`.spectrum`). The equilibria are computed by the
+Rust core (``rvdyn._core``); docs/model.md, "Quasi-static analysis", gives the formulation and
+conventions.
 
 Units are SI: N m, rad, m, N, Pa; results also offer arcmin/arcsec conversions.
 """
