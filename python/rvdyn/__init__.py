@@ -19,6 +19,9 @@ Scene, Options, simulate, sweep, Result
     ``docs/guide.md``.
 order_spectrum, excitation_orders
     Order spectrum of a recorded channel, labelled with the reducer's excitation orders.
+modes, modes_over_mesh, campbell
+    Modes about the loaded equilibrium (energy shares per contact/bearing family), over a
+    mesh period, and the Campbell diagram over input speed.
 rvdyn.plotting
     Matplotlib figures (geometry, contact stiffness).
 """
@@ -47,6 +50,8 @@ from ._core import (
     transmission_ratio,
 )
 from ._types import GapResult, LineContact, OperatingPoint
+from .analysis.campbell import campbell
+from .analysis.modes import modes, modes_over_mesh
 from .analysis.spectrum import excitation_orders, order_spectrum
 from .result import Result
 from .scene import Scene
@@ -74,6 +79,9 @@ __all__ = [
     "INTEGRATORS",
     "order_spectrum",
     "excitation_orders",
+    "modes",
+    "modes_over_mesh",
+    "campbell",
     "CycloidGeometry",
     "InvoluteStage",
     "GapResult",

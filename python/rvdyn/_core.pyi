@@ -43,6 +43,8 @@ __all__ = [
     "LtcaSolver",
     "excitation_orders",
     "campbell_crossings",
+    "modes",
+    "campbell_diagram",
 ]
 
 __version__: str
@@ -472,3 +474,16 @@ def campbell_crossings(
     orders: list[tuple[str, int, float, str]],
 ) -> list[tuple[float, float, int, int]]:
     """Order-line crossings: (speed [rad/s], frequency [Hz], order index, mode index)."""
+
+def modes(scene_json: str, torque: float, crank_angles: list[float]) -> list[dict[str, Any]]:
+    """Modes about the equilibrium at each crank angle [rad] under the output torque [N m]."""
+
+def campbell_diagram(
+    scene_json: str,
+    speeds: list[float],
+    torques: list[float],
+    crank_angle: float = 0.0,
+    harmonics: int = 3,
+    frequency_range: tuple[float, float] | None = None,
+) -> dict[str, Any]:
+    """Natural frequencies over input speeds [rad/s] (torque [N m] per speed) and crossings."""

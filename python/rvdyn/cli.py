@@ -7,6 +7,7 @@ Subcommands::
     rvdyn plot-stiffness [--out DIR]
     rvdyn paper [--out DIR] [--t-end S] [--load {idle,paper,rated,all}] [--integrator NAME]
     rvdyn analyze [SCENE] [--torque NM] [--angles N] [--loop-points N] [--out DIR]
+    rvdyn modes [SCENE] [--torque NM] [--compliant] [--power W] [--speeds LO HI] [--out DIR]
 
 Each subcommand is one entry of :data:`COMMANDS` (name, help, arguments, handler): to add a
 subcommand, write ``_add_x(parser)`` and ``_run_x(args) -> int`` and append one
@@ -332,6 +333,18 @@ def _run_analyze(args: argparse.Namespace) -> int:
     return run(args)
 
 
+def _add_modes(p: argparse.ArgumentParser) -> None:
+    from .analysis.modes import add_cli_arguments
+
+    add_cli_arguments(p)
+
+
+def _run_modes(args: argparse.Namespace) -> int:
+    from .analysis.modes import run_cli
+
+    return run_cli(args)
+
+
 COMMANDS: list[Command] = [
     Command("info", "print the default scene's kinematics, loads, geometry and stiffness",
             _add_info, _run_info),
@@ -343,6 +356,8 @@ COMMANDS: list[Command] = [
             _add_paper, _run_paper),
     Command("analyze", "quasi-static analysis: load distribution, TE both directions, "
             "torque-twist loop, contact pressure, loads for FEA", _add_analyze, _run_analyze),
+    Command("modes", "modes about the loaded equilibrium, energy shares, Campbell diagram",
+            _add_modes, _run_modes),
 ]
 
 

@@ -58,12 +58,31 @@ pub(super) fn damped_modes(
             a[(n + i, n + j)] = -ct[(i, j)];
         }
     }
-    let schur = Schur::try_new(a, f64::EPSILON, 1000 * (2 * n).max(10)).ok_or_else(|| {
+    // The QR iteration stops at a relative subdiagonal of 1e-10 (about half the sweeps of
+    // machine precision); every eigenvalue is then polished on the pencil to round-off. If it
+    // does not converge (QR without exceptional shifts can cycle), retry on the same spectrum
+    // with a different velocity scaling, which changes the iteration's path.
+    let mut raw: Option<Vec<Complex<f64>>> = None;
+    for (attempt, factor) in [1.0, 1.37, 0.61].into_iter().enumerate() {
+        let mut m = a.clone();
+        if attempt > 0 {
+            for i in 0..n {
+                m[(i, n + i)] = s * factor;
+                for j in 0..n {
+                    m[(n + i, j)] = -kt[(i, j)] / (s * factor);
+                }
+            }
+        }
+        if let Some(schur) = Schur::try_new(m, 1e-10, 1000 * (2 * n).max(10)) {
+            raw = Some(schur.complex_eigenvalues().iter().copied().collect());
+            break;
+        }
+    }
+    let raw = raw.ok_or_else(|| {
         RvdynError::Convergence(
             "the Schur iteration for the damped eigenvalues did not converge".into(),
         )
     })?;
-    let raw: Vec<Complex<f64>> = schur.complex_eigenvalues().iter().copied().collect();
     let scale = raw.iter().fold(s, |m, l| m.max(l.norm()));
     let tol_im = 1e-8 * scale;
 
@@ -80,13 +99,15 @@ pub(super) fn damped_modes(
     // Start vectors: the k-th oscillatory eigenvalue starts from the k-th undamped shape of
     // the non-rigid modes (keeps degenerate pairs apart); real ones from a fixed vector.
     let first_flexible = shapes.len().saturating_sub(osc.len());
+    let kc = kt.map(|v| Complex::new(v, 0.0));
+    let cc = ct.map(|v| Complex::new(v, 0.0));
     let mut cands = Vec::with_capacity(osc.len() + real.len());
     for (k, l) in osc.iter().enumerate() {
         let start = shapes
             .get(first_flexible + k)
             .map(|y| y.map(|v| Complex::new(v, 0.0)))
             .unwrap_or_else(|| generic_start(n));
-        let (lambda, x) = polish(kt, ct, *l, start, scale)?;
+        let (lambda, x) = polish(&kc, &cc, *l, start, scale)?;
         cands.push(Candidate {
             lambda,
             x,
@@ -94,7 +115,7 @@ pub(super) fn damped_modes(
         });
     }
     for l in &real {
-        let (lambda, x) = polish(kt, ct, *l, generic_start(n), scale)?;
+        let (lambda, x) = polish(&kc, &cc, *l, generic_start(n), scale)?;
         cands.push(Candidate {
             lambda: Complex::new(lambda.re, 0.0),
             x,
@@ -212,28 +233,31 @@ fn generic_start(n: usize) -> DVector<Complex<f64>> {
     })
 }
 
-/// Inverse iteration at a shift next to `l`, then the pencil's Rayleigh quotient.
+/// Inverse iteration at a shift next to `l`, then the pencil's Rayleigh quotient. `kc`, `cc`:
+/// the reduced stiffness and damping as complex matrices.
 fn polish(
-    kt: &DMatrix<f64>,
-    ct: &DMatrix<f64>,
+    kc: &DMatrix<Complex<f64>>,
+    cc: &DMatrix<Complex<f64>>,
     l: Complex<f64>,
     start: DVector<Complex<f64>>,
     scale: f64,
 ) -> Result<(Complex<f64>, DVector<Complex<f64>>)> {
-    let n = kt.nrows();
-    let kc = kt.map(|v| Complex::new(v, 0.0));
-    let cc = ct.map(|v| Complex::new(v, 0.0));
-    let eye = DMatrix::<Complex<f64>>::identity(n, n);
+    let n = kc.nrows();
     let mut x = start;
-    let mut lambda = l;
     for attempt in 0..3 {
         let delta = 1e-7 * 10f64.powi(attempt) * l.norm().max(1e-6 * scale);
-        let mu = lambda + Complex::new(delta, 0.5 * delta);
-        let p = &eye * (mu * mu) + &cc * mu + &kc;
-        let dp = &eye * (mu * 2.0) + &cc;
+        let mu = l + Complex::new(delta, 0.5 * delta);
+        let mut p = cc * mu + kc;
+        let mut dp = cc.clone();
+        for i in 0..n {
+            p[(i, i)] += mu * mu;
+            dp[(i, i)] += mu * 2.0;
+        }
         let lu = p.lu();
         let mut ok = true;
-        for _ in 0..3 {
+        // Two steps: the shift is 1e-7 of |l| away from an eigenvalue accurate to ~1e-10, so
+        // each step shrinks the other eigen-directions by the ratio of the distances.
+        for _ in 0..2 {
             match lu.solve(&(&dp * &x)) {
                 Some(y) => {
                     let nrm = y.norm();
@@ -251,12 +275,12 @@ fn polish(
         }
         if ok {
             let a: Complex<f64> = x.iter().map(|v| v.norm_sqr()).sum::<f64>().into();
-            let b = x.dotc(&(&cc * &x));
-            let c = x.dotc(&(&kc * &x));
+            let b = x.dotc(&(cc * &x));
+            let c = x.dotc(&(kc * &x));
             let disc = (b * b - a * c * 4.0).sqrt();
             let r1 = (-b + disc) / (a * 2.0);
             let r2 = (-b - disc) / (a * 2.0);
-            lambda = if (r1 - l).norm() <= (r2 - l).norm() {
+            let mut lambda = if (r1 - l).norm() <= (r2 - l).norm() {
                 r1
             } else {
                 r2
@@ -266,7 +290,6 @@ fn polish(
             }
             return Ok((lambda, x));
         }
-        lambda = l;
     }
     Err(RvdynError::Convergence(format!(
         "inverse iteration for the damped eigenvalue {l} failed"

@@ -24,12 +24,17 @@
 //! N m/rad, `C` in N s/m or N m s/rad; frequencies in Hz, eigenvalues in 1/s.
 
 mod damped;
+pub mod linearise;
+pub mod sweep;
 #[cfg(test)]
 mod tests;
 
 use crate::error::{Result, RvdynError};
 use nalgebra::{Complex, DMatrix, DVector, SymmetricEigen};
 use std::f64::consts::TAU;
+
+pub use linearise::{Equilibrium, Linearizer};
+pub use sweep::{Campbell, ModalPoint, campbell, modes_at};
 
 /// One named contribution to the stiffness matrix (a contact family or a bearing family).
 #[derive(Debug, Clone, PartialEq)]

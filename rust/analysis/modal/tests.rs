@@ -282,3 +282,262 @@ fn negative_stiffness_direction_is_flagged_unstable() {
     assert!(rel(r.modes[0].omega_squared, -1.0e3) < 1e-12);
     assert!(!r.modes[1].unstable);
 }
+
+// ---- linearised reducer models ---------------------------------------------------------------
+
+use crate::dynamics::compliant::default_joints;
+use crate::dynamics::scene::{Bearing, Joints, Scene};
+
+fn rated_torque() -> f64 {
+    match Scene::paper("rated").unwrap().load {
+        crate::dynamics::scene::Load::Constant { torque } => torque,
+        _ => unreachable!(),
+    }
+}
+
+fn compliant_scene(k_ecc: f64, k_crank: Option<f64>) -> Scene {
+    let mut s = Scene::paper("rated").unwrap();
+    s.joints = Joints::Compliant {
+        eccentric_bearing: Bearing {
+            stiffness: k_ecc,
+            damping: 1e4,
+            clearance: 0.0,
+        },
+        crank_bearing: k_crank.map(|k| Bearing {
+            stiffness: k,
+            damping: 1e4,
+            clearance: 0.0,
+        }),
+    };
+    s
+}
+
+#[test]
+fn modes_count_equals_the_dof_count() {
+    let t = rated_torque();
+    let rigid = Scene::paper("rated").unwrap();
+    let mut compliant = rigid.clone();
+    compliant.joints = default_joints();
+    for (scene, dof) in [
+        (rigid, 2),
+        (compliant, 16),
+        (compliant_scene(1e9, None), 10),
+    ] {
+        let mut lin = Linearizer::new(&scene).unwrap();
+        let (sys, eq) = lin.linearise(t, 0.1).unwrap();
+        assert_eq!(sys.dof_names.len(), dof);
+        let r = modal_analysis(&sys).unwrap();
+        assert_eq!(r.modes.len(), dof);
+        assert!(eq.split_error < 1e-12, "split {}", eq.split_error);
+        assert!(eq.residual < 1e-9);
+        for m in &r.modes {
+            assert!(!m.unstable && !m.rigid_body && m.frequency > 0.0);
+            let total: f64 = m.energy_share.iter().sum();
+            assert!((total - 1.0).abs() < 1e-9, "{total}");
+            assert!(m.damped.is_some(), "mode at {} Hz unmatched", m.frequency);
+        }
+    }
+}
+
+#[test]
+fn tangent_stiffness_equals_finite_differences_of_the_dynamic_force() {
+    // K = -dQ/dq from the LTCA's analytic tangent against central differences of the dynamic
+    // model's generalised force (a separate implementation of the same forces) at the rated
+    // equilibrium: steps of 1e-8 m at each coordinate's lever; the truncation error of the
+    // 1.5-power law over that step and the round-off of the exact-gap Newton (1e-13 m) are
+    // far below the 1e-5 relative tolerance (measured in the test output).
+    let t = rated_torque();
+    let mut compliant = Scene::paper("rated").unwrap();
+    compliant.joints = default_joints();
+    for scene in [Scene::paper("rated").unwrap(), compliant] {
+        let mut lin = Linearizer::new(&scene).unwrap();
+        let (sys, eq) = lin.linearise(t, 0.37).unwrap();
+        let k = lin.tangent_stiffness(&eq).unwrap();
+        let n = sys.dof_names.len();
+        let zero = vec![0.0; n];
+        let mut fd = DMatrix::<f64>::zeros(n, n);
+        for b in 0..n {
+            let h = 1e-8 / sys.length_scale[b];
+            let mut dq = zero.clone();
+            dq[b] = h;
+            let qp = lin.dynamic_force(&eq, &dq, &zero).unwrap();
+            dq[b] = -h;
+            let qm = lin.dynamic_force(&eq, &dq, &zero).unwrap();
+            for a in 0..n {
+                fd[(a, b)] = -(qp[a] - qm[a]) / (2.0 * h);
+            }
+        }
+        // Compare in displacement units: K_ab L_a^-1 L_b^-1 [N/m].
+        let mut worst: f64 = 0.0;
+        let mut scale: f64 = 0.0;
+        for a in 0..n {
+            for b in 0..n {
+                let s = 1.0 / (sys.length_scale[a] * sys.length_scale[b]);
+                worst = worst.max((k[(a, b)] - fd[(a, b)]).abs() * s);
+                scale = scale.max(k[(a, b)].abs() * s);
+            }
+        }
+        assert!(worst < 1e-5 * scale, "{n} dof: {worst:e} of {scale:e}");
+    }
+}
+
+#[test]
+fn very_stiff_bearings_give_the_rigid_low_modes() {
+    // The compliant model with eccentric and crank bearings 1e4 times the default stiffness
+    // tends to the rigid-joint model (same masses on the rigid manifold): its two lowest modes
+    // must agree with the rigid model's two within 1 %.
+    let t = rated_torque();
+    let mut lin = Linearizer::new(&Scene::paper("rated").unwrap()).unwrap();
+    let (sys, _) = lin.linearise(t, 0.2).unwrap();
+    let rigid = modal_analysis(&sys).unwrap();
+    let mut lin = Linearizer::new(&compliant_scene(1e13, Some(2e13))).unwrap();
+    let (sys, _) = lin.linearise(t, 0.2).unwrap();
+    let stiff = modal_analysis(&sys).unwrap();
+    for i in 0..2 {
+        let (a, b) = (rigid.modes[i].frequency, stiff.modes[i].frequency);
+        assert!(
+            (a - b).abs() < 0.01 * a,
+            "mode {i}: rigid {a} Hz, stiff {b} Hz"
+        );
+    }
+    // The bearings' share of the low modes' strain energy vanishes in that limit.
+    let bearing = stiff
+        .part_names
+        .iter()
+        .position(|p| p == "eccentric bearings")
+        .unwrap();
+    assert!(stiff.modes[0].energy_share[bearing] < 0.01);
+}
+
+// ---- closed forms of the linearised reducer ----------------------------------------------------
+
+use crate::analysis::classical_levers;
+use crate::dynamics::scene::ContactLawSpec;
+use crate::geometry::CycloidGeometry;
+
+fn linear_law(k: f64) -> ContactLawSpec {
+    ContactLawSpec::Impact {
+        stiffness: k,
+        exponent: 1.0,
+        max_damping: 0.0,
+        damping_depth: 1e-5,
+    }
+}
+
+/// Sum of `l^2` over the pins a positive output torque loads (negative classical lever),
+/// both discs.
+fn loaded_lever_sum(g: &CycloidGeometry, psi: f64) -> f64 {
+    [0.0, std::f64::consts::PI]
+        .iter()
+        .flat_map(|ph| classical_levers(g, psi + ph))
+        .filter(|l| *l < 0.0)
+        .map(|l| l * l)
+        .sum()
+}
+
+/// One torsional DOF: rigid joints, cranks held (no first stage), linear pin law `k`, at a
+/// vanishing load (1e-3 N m: the geometric term `F hess g` is ~1e-14 of `k l^2`):
+/// `w^2 = k sum(l_j^2) / M_c` over the loaded pins of both discs, `l_j` the classical
+/// levers. Asserted to 1e-9.
+#[test]
+fn one_dof_reducer_frequency_is_the_closed_form() {
+    let mut s = Scene::paper("rated").unwrap();
+    s.stage1 = None;
+    s.contact.pin = linear_law(1e9);
+    let g = CycloidGeometry::new(s.cycloid).unwrap();
+    let psi = 0.37;
+    let mut lin = Linearizer::new(&s).unwrap();
+    let (sys, _) = lin.linearise(1e-3, psi).unwrap();
+    let r = modal_analysis(&sys).unwrap();
+    assert_eq!(r.modes.len(), 1);
+    let w = (1e9 * loaded_lever_sum(&g, psi) / sys.mass[(0, 0)]).sqrt();
+    let f = w / TAU;
+    assert!((r.modes[0].frequency / f - 1.0).abs() < 1e-9);
+    assert!((r.modes[0].energy_share.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+}
+
+/// Two DOFs (carrier, crank) with the first stage: linear pin law `k`, linear mesh law
+/// `k_m` on `n` meshes. With the classical levers `l_c` about the disc centre and
+/// `l_a = l_c / zc` about the reducer axis: `K_cc = k S2 + n k_m (r_bs + r_bp)^2`,
+/// `K_ca = k S2 / zc - n k_m (r_bs + r_bp) r_bp`, `K_aa = k S2 / zc^2 + n k_m r_bp^2`
+/// (`S2 = sum l_c^2`), and the frequencies from `det(K - w^2 M) = 0`. Asserted to 1e-9.
+#[test]
+fn two_dof_reducer_frequencies_are_the_closed_form() {
+    let mut s = Scene::paper("rated").unwrap();
+    let (k, km) = (1e9, 3e8);
+    s.contact.pin = linear_law(k);
+    s.contact.mesh = linear_law(km);
+    let g = CycloidGeometry::new(s.cycloid).unwrap();
+    let psi = 0.21;
+    let mut lin = Linearizer::new(&s).unwrap();
+    let (sys, _) = lin.linearise(1e-3, psi).unwrap();
+    let r = modal_analysis(&sys).unwrap();
+    assert_eq!(r.modes.len(), 2);
+    let rm = crate::dynamics::RigidModel::new(&s).unwrap();
+    let mesh = rm.mesh.unwrap();
+    let (rbs, rbp, n) = (
+        mesh.sun_base_radius,
+        mesh.planet_base_radius,
+        mesh.count as f64,
+    );
+    let s2 = loaded_lever_sum(&g, psi);
+    let zc = 23.0;
+    let kcc = k * s2 + n * km * (rbs + rbp).powi(2);
+    let kca = k * s2 / zc - n * km * (rbs + rbp) * rbp;
+    let kaa = k * s2 / (zc * zc) + n * km * rbp * rbp;
+    let (mc, ma) = (sys.mass[(0, 0)], sys.mass[(1, 1)]);
+    let a = mc * ma;
+    let b = -(kcc * ma + kaa * mc);
+    let c = kcc * kaa - kca * kca;
+    let disc = (b * b - 4.0 * a * c).sqrt();
+    let w2 = [(-b - disc) / (2.0 * a), (-b + disc) / (2.0 * a)];
+    for (m, w2) in r.modes.iter().zip(w2) {
+        let f = w2.sqrt() / TAU;
+        assert!((m.frequency / f - 1.0).abs() < 1e-9, "{} {f}", m.frequency);
+    }
+    assert_eq!(
+        r.part_names,
+        vec![
+            "pin contacts disc 0",
+            "pin contacts disc 1",
+            "sun/planet meshes"
+        ]
+    );
+}
+
+/// The mode table of the paper scene at rated load, rigid and compliant (printed; run with
+/// `--ignored --nocapture`).
+#[test]
+#[ignore]
+fn print_paper_mode_tables() {
+    let t = rated_torque();
+    let mut compliant = Scene::paper("rated").unwrap();
+    compliant.joints = default_joints();
+    for scene in [Scene::paper("rated").unwrap(), compliant] {
+        let mut lin = Linearizer::new(&scene).unwrap();
+        let (sys, eq) = lin.linearise(t, 0.1).unwrap();
+        let r = modal_analysis(&sys).unwrap();
+        println!(
+            "split error {:.1e}; parts {:?}",
+            eq.split_error, r.part_names
+        );
+        for m in &r.modes {
+            let z = m
+                .damped
+                .as_ref()
+                .map_or(m.modal_damping_ratio, |d| d.damping_ratio);
+            let shares: Vec<String> = m
+                .energy_share
+                .iter()
+                .map(|e| format!("{:.0}", 100.0 * e))
+                .collect();
+            println!(
+                "{:10.1} Hz  zeta {:.4}  {:16}  energy % {}",
+                m.frequency,
+                z,
+                r.dof_names[m.dominant_dof],
+                shares.join(" ")
+            );
+        }
+    }
+}
