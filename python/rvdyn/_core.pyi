@@ -41,9 +41,10 @@ __all__ = [
     "simulate",
     "sweep",
     "LtcaSolver",
-    "modes",
     "excitation_orders",
     "campbell_crossings",
+    "modes",
+    "campbell_diagram",
 ]
 
 __version__: str
@@ -444,7 +445,7 @@ def sweep(
     """Run many scenes in parallel; per scene (arrays, statistics) or the exception it raised.
     Ctrl-C stops every run (KeyboardInterrupt)."""
 
-# ---- quasi-static and modal analysis (rust/python/ltca.rs; wrapped by rvdyn.analysis) -------
+# ---- quasi-static analysis (rust/python/ltca.rs; wrapped by rvdyn.analysis) -----------------
 
 @final
 class LtcaSolver:
@@ -469,13 +470,27 @@ class LtcaSolver:
     def twist_loop(self, rated: float, crank_angle: float, points: int) -> dict[str, Any]:
         """Torque-twist loop with rigidity, lost motion and backlash."""
 
-def modes(scene: CompiledScene, torque: float, crank_angle: float) -> dict[str, Any]:
-    """Modes about the LTCA equilibrium at crank_angle [rad] under torque [N m]."""
+# ---- vibration analyses (rust/python/modal.rs) ------------------------------------------------
 
-def excitation_orders(scene: CompiledScene) -> list[tuple[str, float]]:
-    """Excitation orders (name, multiple of the input rotation frequency)."""
+def excitation_orders(scene_json: str, harmonics: int = 3) -> list[tuple[str, int, float, str]]:
+    """Excitation orders of a scene as (name, harmonic, order, label), by increasing order."""
 
 def campbell_crossings(
-    frequencies: Sequence[float], orders: Sequence[tuple[str, float]], speed_min: float, speed_max: float
-) -> list[dict[str, Any]]:
-    """Crossings of the orders with the natural frequencies [Hz] for input speeds [rad/s]."""
+    speeds: list[float],
+    frequencies: list[list[float]],
+    orders: list[tuple[str, int, float, str]],
+) -> list[tuple[float, float, int, int]]:
+    """Order-line crossings: (speed [rad/s], frequency [Hz], order index, mode index)."""
+
+def modes(scene_json: str, torque: float, crank_angles: list[float]) -> list[dict[str, Any]]:
+    """Modes about the equilibrium at each crank angle [rad] under the output torque [N m]."""
+
+def campbell_diagram(
+    scene_json: str,
+    speeds: list[float],
+    torques: list[float],
+    crank_angle: float = 0.0,
+    harmonics: int = 3,
+    frequency_range: tuple[float, float] | None = None,
+) -> dict[str, Any]:
+    """Natural frequencies over input speeds [rad/s] (torque [N m] per speed) and crossings."""

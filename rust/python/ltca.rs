@@ -235,77 +235,8 @@ fn pack<'py>(py: Python<'py>, pts: &[LtcaPoint]) -> PyResult<Bound<'py, PyDict>>
     Ok(d)
 }
 
-/// Modes of `scene` about its equilibrium at `crank_angle` [rad] under `torque` [N m]: a dict
-/// with `dofs`, `families` (names), `mass` (dofs,), `frequency`, `damping_ratio` (modes,),
-/// `shape` (modes, dofs), `energy` (modes, families), `torque`, `crank_angle`.
-#[pyfunction]
-fn modes<'py>(
-    py: Python<'py>,
-    scene: &CompiledScene,
-    torque: f64,
-    crank_angle: f64,
-) -> PyResult<Bound<'py, PyDict>> {
-    let sc = scene.scene.clone();
-    let m = py.detach(|| crate::analysis::modal::modes(&sc, torque, crank_angle))?;
-    let d = PyDict::new(py);
-    let (nm, nd, nf) = (m.modes.len(), m.dofs.len(), m.families.len());
-    d.set_item("dofs", m.dofs.clone())?;
-    d.set_item("families", m.families.clone())?;
-    d.set_item("mass", f64_array(py, m.mass.clone(), vec![nd])?)?;
-    let col = |f: &dyn Fn(&crate::analysis::modal::Mode) -> f64| {
-        m.modes.iter().map(f).collect::<Vec<f64>>()
-    };
-    d.set_item("frequency", f64_array(py, col(&|x| x.frequency), vec![nm])?)?;
-    d.set_item(
-        "damping_ratio",
-        f64_array(py, col(&|x| x.damping_ratio), vec![nm])?,
-    )?;
-    let shape: Vec<f64> = m.modes.iter().flat_map(|x| x.shape.clone()).collect();
-    d.set_item("shape", f64_array(py, shape, vec![nm, nd])?)?;
-    let energy: Vec<f64> = m.modes.iter().flat_map(|x| x.energy.clone()).collect();
-    d.set_item("energy", f64_array(py, energy, vec![nm, nf])?)?;
-    d.set_item("torque", m.torque)?;
-    d.set_item("crank_angle", m.crank_angle)?;
-    Ok(d)
-}
-
-/// The excitation orders of `scene` as (name, multiple of the input rotation frequency).
-#[pyfunction]
-fn excitation_orders(scene: &CompiledScene) -> Vec<(String, f64)> {
-    crate::analysis::modal::excitation_orders(&scene.scene)
-}
-
-/// Crossings of `orders` with `frequencies` [Hz] for input speeds in [`speed_min`,
-/// `speed_max`] [rad/s], as dicts (order, order_value, mode (1-based), frequency,
-/// input_speed).
-#[pyfunction]
-fn campbell_crossings<'py>(
-    py: Python<'py>,
-    frequencies: Vec<f64>,
-    orders: Vec<(String, f64)>,
-    speed_min: f64,
-    speed_max: f64,
-) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let c =
-        crate::analysis::modal::campbell_crossings(&frequencies, &orders, speed_min, speed_max)?;
-    c.into_iter()
-        .map(|x| {
-            let d = PyDict::new(py);
-            d.set_item("order", x.order)?;
-            d.set_item("order_value", x.order_value)?;
-            d.set_item("mode", x.mode + 1)?;
-            d.set_item("frequency", x.frequency)?;
-            d.set_item("input_speed", x.input_speed)?;
-            Ok(d)
-        })
-        .collect()
-}
-
-/// Add the solver class and the modal functions to the module.
+/// Add the solver class to the module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<LtcaSolver>()?;
-    m.add_function(wrap_pyfunction!(modes, m)?)?;
-    m.add_function(wrap_pyfunction!(excitation_orders, m)?)?;
-    m.add_function(wrap_pyfunction!(campbell_crossings, m)?)?;
     Ok(())
 }

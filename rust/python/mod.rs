@@ -13,6 +13,7 @@ mod errors;
 mod geometry;
 mod kinematics;
 mod ltca;
+mod modal;
 mod scene;
 mod simulate;
 
@@ -40,5 +41,6 @@ fn rvdyn_core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scene::register(m)?;
     simulate::register(m)?;
     ltca::register(m)?;
+    modal::register(m)?;
     Ok(())
 }

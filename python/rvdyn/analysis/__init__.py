@@ -1,7 +1,9 @@
-"""Quasi-static analysis: loaded tooth contact analysis (LTCA), transmission error in both
+"""Analyses of scenes and results: loaded tooth contact analysis (LTCA), transmission error in both
 drive directions, the torque-twist loop (rigidity, lost motion, backlash) and contact loads for
-FEA. The equilibria are computed by the Rust core (``rvdyn._core``); docs/model.md,
-"Quasi-static analysis", gives the formulation and conventions.
+FEA; order spectra of dynamic runs (:mod:`.spectrum`), modes about the loaded equilibrium
+(:mod:`.modes`) and Campbell diagrams (:mod:`.campbell`). The equilibria are computed by the
+Rust core (``rvdyn._core``); docs/model.md, "Quasi-static analysis", gives the formulation and
+conventions.
 
 Units are SI: N m, rad, m, N, Pa; results also offer arcmin/arcsec conversions.
 """

@@ -229,7 +229,11 @@ impl Ltca {
 
     /// The equilibrium unknowns at `psi` and `torque`, warm-started from the last solution
     /// (its deflection carried to the new kinematic pose). Returns them with the report.
-    fn solve_unknowns(&mut self, torque: f64, psi: f64) -> Result<(Vec<f64>, NewtonReport)> {
+    pub(crate) fn solve_unknowns(
+        &mut self,
+        torque: f64,
+        psi: f64,
+    ) -> Result<(Vec<f64>, NewtonReport)> {
         require_finite("torque", torque)?;
         require_finite("crank angle", psi)?;
         let st = &mut self.statics;
