@@ -19,6 +19,11 @@ Scene, Options, simulate, sweep, Result
     ``docs/guide.md``.
 study
     Tolerance studies (Monte Carlo / Latin hypercube, threads / processes / Dask / Ray).
+order_spectrum, excitation_orders
+    Order spectrum of a recorded channel, labelled with the reducer's excitation orders.
+modes, modes_over_mesh, campbell
+    Modes about the loaded equilibrium (energy shares per contact/bearing family), over a
+    mesh period, and the Campbell diagram over input speed.
 rvdyn.plotting
     Matplotlib figures (geometry, contact stiffness).
 """
@@ -47,9 +52,13 @@ from ._core import (
     transmission_ratio,
 )
 from ._types import GapResult, LineContact, OperatingPoint
+from .analysis.campbell import campbell
+from .analysis.modes import modes, modes_over_mesh
+from .analysis.spectrum import excitation_orders, order_spectrum
 from .result import Result
 from .scene import Scene
 from .simulation import INTEGRATORS, Options, simulate, sweep
+from .analysis import ltca
 from .errors import (
     ConvergenceError,
     GeometryError,
@@ -69,8 +78,14 @@ __all__ = [
     "Options",
     "simulate",
     "sweep",
+    "ltca",
     "study",
     "INTEGRATORS",
+    "order_spectrum",
+    "excitation_orders",
+    "modes",
+    "modes_over_mesh",
+    "campbell",
     "CycloidGeometry",
     "InvoluteStage",
     "GapResult",

@@ -40,6 +40,11 @@ __all__ = [
     "channels",
     "simulate",
     "sweep",
+    "LtcaSolver",
+    "excitation_orders",
+    "campbell_crossings",
+    "modes",
+    "campbell_diagram",
 ]
 
 __version__: str
@@ -439,3 +444,53 @@ def sweep(
 ) -> list[tuple[dict[str, NDArray[Any]], dict[str, Any]] | BaseException]:
     """Run many scenes in parallel; per scene (arrays, statistics) or the exception it raised.
     Ctrl-C stops every run (KeyboardInterrupt)."""
+
+# ---- quasi-static analysis (rust/python/ltca.rs; wrapped by rvdyn.analysis) -----------------
+
+@final
+class LtcaSolver:
+    """The loaded tooth contact analysis of one scene; keeps its warm start and points."""
+
+    def __new__(cls, scene: CompiledScene, tolerance: float) -> LtcaSolver: ...
+    @property
+    def mesh_period(self) -> float:
+        """Crank-angle period of the contact pattern [rad]."""
+    @property
+    def ratio(self) -> float:
+        """Transmission ratio input/output."""
+    @property
+    def face_width(self) -> float:
+        """Disc face width [m]."""
+    def sweep(self, torque: float, crank_angles: Sequence[float]) -> dict[str, NDArray[Any]]:
+        """Equilibria at crank_angles [rad] under torque [N m]: numpy arrays, crank angle first."""
+    def fea_loads(self) -> tuple[str, str]:
+        """Worst load case per disc over every point solved so far: (CSV, JSON)."""
+    def transmission_error(self, torque: float, light: float, points: int, start: float) -> dict[str, Any]:
+        """TE over one mesh period at +-torque and +-light [N m]."""
+    def twist_loop(self, rated: float, crank_angle: float, points: int) -> dict[str, Any]:
+        """Torque-twist loop with rigidity, lost motion and backlash."""
+
+# ---- vibration analyses (rust/python/modal.rs) ------------------------------------------------
+
+def excitation_orders(scene_json: str, harmonics: int = 3) -> list[tuple[str, int, float, str]]:
+    """Excitation orders of a scene as (name, harmonic, order, label), by increasing order."""
+
+def campbell_crossings(
+    speeds: list[float],
+    frequencies: list[list[float]],
+    orders: list[tuple[str, int, float, str]],
+) -> list[tuple[float, float, int, int]]:
+    """Order-line crossings: (speed [rad/s], frequency [Hz], order index, mode index)."""
+
+def modes(scene_json: str, torque: float, crank_angles: list[float]) -> list[dict[str, Any]]:
+    """Modes about the equilibrium at each crank angle [rad] under the output torque [N m]."""
+
+def campbell_diagram(
+    scene_json: str,
+    speeds: list[float],
+    torques: list[float],
+    crank_angle: float = 0.0,
+    harmonics: int = 3,
+    frequency_range: tuple[float, float] | None = None,
+) -> dict[str, Any]:
+    """Natural frequencies over input speeds [rad/s] (torque [N m] per speed) and crossings."""

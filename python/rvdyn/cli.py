@@ -6,7 +6,9 @@ Subcommands::
     rvdyn plot-geometry [--out DIR] [--psi RAD]
     rvdyn plot-stiffness [--out DIR]
     rvdyn paper [--out DIR] [--t-end S] [--load {idle,paper,rated,all}] [--integrator NAME]
+    rvdyn analyze [SCENE] [--torque NM] [--angles N] [--loop-points N] [--out DIR]
     rvdyn study SPEC.toml [--out DIR] [--samples N] [--no-plots]
+    rvdyn modes [SCENE] [--torque NM] [--compliant] [--power W] [--speeds LO HI] [--out DIR]
 
 Each subcommand is one entry of :data:`COMMANDS` (name, help, arguments, handler): to add a
 subcommand, write ``_add_x(parser)`` and ``_run_x(args) -> int`` and append one
@@ -385,6 +387,18 @@ def _run_paper(args: argparse.Namespace) -> int:
     return int(result) if result is not None else 0
 
 
+def _add_analyze(p: argparse.ArgumentParser) -> None:
+    from .analysis.cli import add_arguments
+
+    add_arguments(p)
+
+
+def _run_analyze(args: argparse.Namespace) -> int:
+    from .analysis.cli import run
+
+    return run(args)
+
+
 # ---------------------------------------------------------------------------------------------
 # study (rvdyn.study.config)
 
@@ -406,6 +420,18 @@ def _run_study(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_modes(p: argparse.ArgumentParser) -> None:
+    from .analysis.modes import add_cli_arguments
+
+    add_cli_arguments(p)
+
+
+def _run_modes(args: argparse.Namespace) -> int:
+    from .analysis.modes import run_cli
+
+    return run_cli(args)
+
+
 COMMANDS: list[Command] = [
     Command("info", "print the default scene's kinematics, loads, geometry and stiffness",
             _add_info, _run_info),
@@ -415,8 +441,12 @@ COMMANDS: list[Command] = [
             _add_plot_stiffness, _run_plot_stiffness),
     Command("paper", "run the paper's simulations on the default scene and write figures",
             _add_paper, _run_paper),
+    Command("analyze", "quasi-static analysis: load distribution, TE both directions, "
+            "torque-twist loop, contact pressure, loads for FEA", _add_analyze, _run_analyze),
     Command("study", "run a tolerance study from a TOML spec (table, statistics, plots)", _add_study,
             _run_study),
+    Command("modes", "modes about the loaded equilibrium, energy shares, Campbell diagram",
+            _add_modes, _run_modes),
 ]
 
 

@@ -187,6 +187,13 @@ class Result:
         t_window = 0.5 * (lo + hi)
         return t_window, float(t[-1])
 
+    def spectrum(self, channel: str, window: tuple[float, float] | None = None, **options: Any) -> Any:
+        """Order spectrum of ``channel`` over ``window`` [s] with peaks labelled by the excitation
+        orders: :func:`rvdyn.order_spectrum` (options as there)."""
+        from .analysis.spectrum import order_spectrum
+
+        return order_spectrum(self, channel, window, **options)
+
     def mean_output_speed(self, t_start: float | None = None) -> float:
         """Mean carrier speed [rad/s] over whole crank revolutions after ``t_start`` [s]:
         (angle change) / (time), exact for the recorded angles, no averaging of samples."""

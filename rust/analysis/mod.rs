@@ -2,6 +2,9 @@
 
 pub mod efficiency;
 pub mod load_sharing;
+pub mod ltca;
+pub mod modal;
 pub mod pin_load_sharing;
+pub mod orders;
 
 pub use load_sharing::{classical_levers, classical_pin_forces};

@@ -8,6 +8,7 @@ pub mod hertz;
 pub mod impact;
 pub mod law;
 pub mod line_contact;
+pub mod pin_tangent;
 pub mod stiffness;
 
 pub use hertz::{LineContact, Material, effective_modulus, hertz_line_contact};

@@ -12,6 +12,8 @@ mod contact;
 mod errors;
 mod geometry;
 mod kinematics;
+mod ltca;
+mod modal;
 mod scene;
 mod simulate;
 
@@ -38,5 +40,7 @@ fn rvdyn_core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     kinematics::register(m)?;
     scene::register(m)?;
     simulate::register(m)?;
+    ltca::register(m)?;
+    modal::register(m)?;
     Ok(())
 }

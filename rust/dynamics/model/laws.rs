@@ -46,6 +46,34 @@ impl ContactLaw {
         }
     }
 
+    /// Elastic force [N] and its derivative, the static contact stiffness [N/m], at penetration
+    /// `x` [m] (both 0 for `x <= 0`): the contact's part of the tangent stiffness (quasi-static
+    /// analysis and modes).
+    #[inline]
+    pub fn elastic_force_and_stiffness(&self, x: f64) -> (f64, f64) {
+        if x <= 0.0 {
+            return (0.0, 0.0);
+        }
+        match self {
+            ContactLaw::Impact(l) => {
+                let (f, df, _) = l.force_and_derivatives(x, 0.0);
+                (f, df)
+            }
+        }
+    }
+
+    /// Damping coefficient `dF/dx'` [N s/m] at penetration `x` [m] and zero rate (0 for
+    /// `x <= 0`): the contact's part of the linearised damping matrix.
+    #[inline]
+    pub fn damping_coefficient(&self, x: f64) -> f64 {
+        if x <= 0.0 {
+            return 0.0;
+        }
+        match self {
+            ContactLaw::Impact(l) => l.force_and_derivatives(x, 0.0).2,
+        }
+    }
+
     /// A mesh with total backlash `backlash` [m] along the line of action at deflection
     /// `delta` [m] (positive on the drive flank) and rate `rate` [m/s]: the signed force [N]
     /// (negative on the coast flank), its signed elastic part, the penetration [m] (0 inside
@@ -131,6 +159,94 @@ impl BearingLaw {
                     out.energy += l.energy;
                 }
                 out
+            }
+        }
+    }
+}
+
+impl BearingLaw {
+    /// Static tangent of the bearing at deflection `d` [m] and zero rate: the gradient of its
+    /// potential `dV/dd` [N] (minus the force on the `+` body) and its Hessian `hess_d V`
+    /// [N/m]: `F n` and `F' n n^T + (F/|d|)(I - n n^T)` for the radial law `F(|d| - c)` along
+    /// `n = d/|d|`, `k d` and `k I` without clearance (docs/model.md, quasi-static analysis).
+    #[inline]
+    pub fn static_tangent(&self, d: [f64; 2]) -> ([f64; 2], [[f64; 2]; 2]) {
+        match self {
+            BearingLaw::Rollers { .. } => {
+                // Central differences of the force at zero rate (step 1 nm; the roller law is
+                // smooth away from each roller's first contact).
+                let f = |x: [f64; 2]| self.load(x, [0.0; 2]).force;
+                let f0 = f(d);
+                let h = 1e-9;
+                let mut hess = [[0.0; 2]; 2];
+                for c in 0..2 {
+                    let (mut a, mut b) = (d, d);
+                    a[c] += h;
+                    b[c] -= h;
+                    let (fa, fb) = (f(a), f(b));
+                    for (r, row) in hess.iter_mut().enumerate() {
+                        row[c] = -(fa[r] - fb[r]) / (2.0 * h);
+                    }
+                }
+                ([-f0[0], -f0[1]], hess)
+            }
+            BearingLaw::Linear(b) => {
+                if b.clearance <= 0.0 {
+                    let k = b.stiffness;
+                    return ([k * d[0], k * d[1]], [[k, 0.0], [0.0, k]]);
+                }
+                let len = dot(d, d).sqrt();
+                let pen = len - b.clearance;
+                if pen <= 0.0 {
+                    return ([0.0; 2], [[0.0; 2]; 2]);
+                }
+                let (f, fp) = (b.stiffness * pen, b.stiffness);
+                let n = [d[0] / len, d[1] / len];
+                let t = f / len;
+                let mut h = [[0.0; 2]; 2];
+                for (a, row) in h.iter_mut().enumerate() {
+                    for (c, v) in row.iter_mut().enumerate() {
+                        let id = if a == c { 1.0 } else { 0.0 };
+                        *v = fp * n[a] * n[c] + t * (id - n[a] * n[c]);
+                    }
+                }
+                ([f * n[0], f * n[1]], h)
+            }
+        }
+    }
+
+    /// Damping matrix `dF/dd'` [N s/m] at deflection `d` and zero rate: `c I` without
+    /// clearance, `c n n^T` beyond it, 0 inside.
+    #[inline]
+    pub fn damping_matrix(&self, d: [f64; 2]) -> [[f64; 2]; 2] {
+        match self {
+            BearingLaw::Rollers { .. } => {
+                let h = 1e-6;
+                let mut c = [[0.0; 2]; 2];
+                for k in 0..2 {
+                    let (mut a, mut b) = ([0.0; 2], [0.0; 2]);
+                    a[k] = h;
+                    b[k] = -h;
+                    let (fa, fb) = (self.load(d, a).force, self.load(d, b).force);
+                    for (r, row) in c.iter_mut().enumerate() {
+                        row[k] = -(fa[r] - fb[r]) / (2.0 * h);
+                    }
+                }
+                c
+            }
+            BearingLaw::Linear(b) => {
+                if b.clearance <= 0.0 {
+                    return [[b.damping, 0.0], [0.0, b.damping]];
+                }
+                let len = dot(d, d).sqrt();
+                if len <= b.clearance {
+                    return [[0.0; 2]; 2];
+                }
+                let n = [d[0] / len, d[1] / len];
+                [
+                    [b.damping * n[0] * n[0], b.damping * n[0] * n[1]],
+                    [b.damping * n[1] * n[0], b.damping * n[1] * n[1]],
+                ]
             }
         }
     }

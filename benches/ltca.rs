@@ -1,0 +1,59 @@
+//! Quasi-static analysis speed: LTCA of one crank angle, a mesh period at 360 crank angles and a
+//! 200-point torque-twist loop, on the paper's scene with compliant bearings and the line
+//! (Palmgren) pin law at rated torque.
+use criterion::{Criterion, criterion_group, criterion_main};
+use rvdyn::analysis::ltca::Ltca;
+use rvdyn::dynamics::compliant::default_joints;
+use rvdyn::dynamics::scene::{ContactLawSpec, Scene};
+use std::hint::black_box;
+
+fn scene() -> Scene {
+    let mut s = Scene::paper("rated").expect("paper scene");
+    s.joints = default_joints();
+    s.contact.pin = ContactLawSpec::Palmgren {
+        max_damping: 1e5,
+        damping_depth: 1e-5,
+    };
+    s
+}
+
+fn bench_ltca(c: &mut Criterion) {
+    let s = scene();
+    let torque = s.load.torque(0.0);
+    let mut ltca = Ltca::new(&s).expect("ltca");
+    let period = ltca.mesh_period();
+    let angles: Vec<f64> = (0..360).map(|i| period * i as f64 / 360.0).collect();
+    // One crank angle in a sweep: warm-started from the previous angle, a step of 1/360 of
+    // the period.
+    ltca.solve(torque, 0.0).expect("first angle");
+    let mut k = 0usize;
+    c.bench_function("ltca/one_crank_angle_warm", |b| {
+        b.iter(|| {
+            k += 1;
+            let psi = period * (k % 360) as f64 / 360.0;
+            black_box(ltca.solve(black_box(torque), psi).expect("solve"))
+        })
+    });
+    c.bench_function("ltca/one_crank_angle_cold", |b| {
+        b.iter(|| {
+            ltca.reset();
+            black_box(ltca.solve(black_box(torque), 0.1).expect("solve"))
+        })
+    });
+    c.bench_function("ltca/mesh_period_360_angles", |b| {
+        b.iter(|| {
+            ltca.reset();
+            black_box(ltca.sweep(black_box(torque), &angles).expect("sweep"))
+        })
+    });
+    c.bench_function("ltca/twist_loop_200_points", |b| {
+        b.iter(|| black_box(ltca.twist_loop(black_box(torque), 0.0, 200).expect("loop")))
+    });
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20);
+    targets = bench_ltca
+}
+criterion_main!(benches);

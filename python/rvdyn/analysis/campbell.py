@@ -1,0 +1,136 @@
+"""Campbell diagram of a loaded reducer: natural frequencies over input speed with the
+excitation orders and their crossings (docs/model.md, "Campbell diagram").
+
+The paper's travel speeds 3.3-5.5 km/h map to input speeds by proportion: 3.3 km/h is the
+paper's 8328 deg/s ([P] section 4.1), so 5.5 km/h is 13880 deg/s (:func:`travel_to_input_speed`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import numpy as np
+
+from .. import _core
+from ..errors import ParameterError
+from .modes import _finite, _scene, scene_torque
+from .spectrum import ExcitationOrder
+
+__all__ = ["CampbellDiagram", "Crossing", "campbell", "travel_to_input_speed", "PAPER_TRAVEL_RANGE_KMH"]
+
+#: The paper's travel speed range [km/h] ([P] section 4.1).
+PAPER_TRAVEL_RANGE_KMH = (3.3, 5.5)
+_PAPER_INPUT_AT_3_3 = math.radians(8328.0)  # rad/s at 3.3 km/h
+
+
+def travel_to_input_speed(kmh: float | np.ndarray) -> Any:
+    """Input speed [rad/s] of the paper's travel drive at a travel speed [km/h]: proportional,
+    8328 deg/s at 3.3 km/h ([P] section 4.1; implied wheel radius 0.3595 m)."""
+    return np.asarray(kmh, dtype=float) * (_PAPER_INPUT_AT_3_3 / 3.3)
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """An order line meeting a mode: input ``speed`` [rad/s], ``frequency`` [Hz], the
+    ``order`` and the mode (``mode``: 0-based index into the diagram's modes)."""
+
+    speed: float
+    frequency: float
+    order: ExcitationOrder
+    mode: int
+
+    @property
+    def travel_speed_kmh(self) -> float:
+        """The paper's travel speed [km/h] at this input speed."""
+        return self.speed * 3.3 / _PAPER_INPUT_AT_3_3
+
+
+@dataclass
+class CampbellDiagram:
+    """Natural frequencies [Hz] (speeds, modes) over input ``speeds`` [rad/s] with the output
+    torque [N m] at each speed, the damping ratios, the excitation orders and the crossings."""
+
+    speeds: np.ndarray
+    torques: np.ndarray
+    frequency: np.ndarray
+    damping_ratio: np.ndarray
+    modes: list[int]
+    orders: list[ExcitationOrder]
+    crossings: list[Crossing]
+    crank_angle: float
+
+    def table(self) -> list[dict[str, Any]]:
+        """One row per crossing (input speed in rad/s and deg/s, travel speed of the paper's
+        drive in km/h, frequency [Hz], order label, mode number, damping ratio there)."""
+        rows = []
+        for c in self.crossings:
+            zeta = float(np.interp(c.speed, self.speeds, self.damping_ratio[:, c.mode]))
+            rows.append({"input_speed_rad_s": c.speed, "input_speed_deg_s": math.degrees(c.speed),
+                         "travel_speed_kmh": c.travel_speed_kmh, "frequency_hz": c.frequency,
+                         "order": c.order.label, "order_value": c.order.order, "mode": c.mode + 1,
+                         "damping_ratio": zeta})
+        return rows
+
+    def plot(self, ax: Any = None, max_frequency: float | None = None) -> Any:
+        """Natural frequencies and order lines against the input speed [deg/s], crossings
+        marked."""
+        if ax is None:
+            import matplotlib.pyplot as plt
+
+            ax = plt.subplots(figsize=(9, 6))[1]
+        deg = np.degrees(self.speeds)
+        for m in range(self.frequency.shape[1]):
+            ax.plot(deg, self.frequency[:, m], color="k", lw=1)
+        for i, o in enumerate(self.orders):
+            f = o.order * self.speeds / (2 * math.pi)
+            ax.plot(deg, f, ls="--", lw=0.8, color=f"C{i % 10}", label=o.label)
+        if self.crossings:
+            ax.plot([math.degrees(c.speed) for c in self.crossings], [c.frequency for c in self.crossings],
+                    "o", mfc="none", color="r", label="crossings")
+        top = max_frequency or 1.1 * float(self.frequency.max())
+        ax.set(xlabel="input speed [deg/s]", ylabel="frequency [Hz]", ylim=(0, top),
+               title=f"Campbell diagram (crank angle {self.crank_angle:.3g} rad)")
+        ax.legend(fontsize="x-small", ncol=2, loc="upper left")
+        return ax
+
+
+def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, power: float | None = None,
+             torque: float | None = None, crank_angle: float = 0.0, harmonics: int = 3,
+             frequency_range: tuple[float, float] | None = None, points: int = 200) -> CampbellDiagram:
+    """Campbell diagram of ``scene`` over the input ``speeds`` [rad/s] (increasing; default
+    ``points`` speeds over the paper's travel range 3.3-5.5 km/h, 145.4-242.3 rad/s).
+
+    The modes at each speed are those about the equilibrium at ``crank_angle`` [rad] under the
+    output torque of that speed: constant ``torque`` [N m], or ``power`` [W] transmitted
+    (``T = power x ratio / speed``), or (neither given) the scene's load torque. The models have
+    no speed-dependent terms, so the speed enters through the torque only. ``frequency_range``
+    [Hz] keeps the modes inside it (``ParameterError`` if none is); pin-pass and sun-mesh
+    harmonics up to ``harmonics``."""
+    scene = _scene(scene)
+    if speeds is None:
+        if not isinstance(points, (int, np.integer)) or points < 2:
+            raise ParameterError(f"points must be a whole number >= 2, got {points!r}")
+        lo, hi = (float(v) for v in travel_to_input_speed(np.array(PAPER_TRAVEL_RANGE_KMH)))
+        speeds = np.linspace(lo, hi, int(points))
+    w = np.asarray(speeds, dtype=float).ravel()
+    if power is not None and torque is not None:
+        raise ParameterError("give power or torque, not both")
+    if power is not None:
+        p = _finite("power", power, "W")
+        with np.errstate(divide="ignore"):
+            t = p * float(scene.ratio) / w
+    else:
+        t = np.full(w.shape, scene_torque(scene) if torque is None else _finite("torque", torque, "N m"))
+    if not np.all(np.isfinite(t)):
+        raise ParameterError("input speeds must be finite and > 0 rad/s")
+    if frequency_range is not None:
+        frequency_range = (_finite("frequency_range[0]", frequency_range[0], "Hz"),
+                           _finite("frequency_range[1]", frequency_range[1], "Hz"))
+    d = _core.campbell_diagram(scene.to_json(), [float(x) for x in w], [float(x) for x in t],
+                               _finite("crank_angle", crank_angle, "rad"), int(harmonics), frequency_range)
+    orders = [ExcitationOrder(n, int(h), float(o), lab) for n, h, o, lab in d["orders"]]
+    crossings = [Crossing(float(s), float(f), orders[int(o)], int(m)) for s, f, o, m in d["crossings"]]
+    return CampbellDiagram(w, t, np.asarray(d["frequency"]), np.asarray(d["damping_ratio"]), list(d["modes"]),
+                           orders, crossings, float(crank_angle))

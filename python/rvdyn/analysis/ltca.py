@@ -1,0 +1,315 @@
+"""Loaded tooth contact analysis and what follows from it (see :mod:`rvdyn.analysis`)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Sequence
+
+import numpy as np
+
+from .. import _core
+from ..errors import ParameterError
+from ..scene import Scene
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["ARCMIN", "ARCSEC", "LtcaResult", "TransmissionError", "TwistLoop", "ltca",
+           "torque_twist", "transmission_error"]
+
+#: One arc minute and one arc second [rad].
+ARCMIN: float = math.pi / (180.0 * 60.0)
+ARCSEC: float = math.pi / (180.0 * 3600.0)
+
+
+def _scene(scene: object) -> Scene:
+    if not isinstance(scene, Scene):
+        raise ParameterError(
+            f"scene must be an rvdyn.Scene (e.g. rvdyn.Scene.paper('rated')), got {type(scene).__name__}")
+    return scene
+
+
+def _float(name: str, value: object, unit: str) -> float:
+    try:
+        x = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a number [{unit}], got {value!r}") from None
+    if not math.isfinite(x):
+        raise ParameterError(f"{name} must be a finite number [{unit}], got {x}")
+    return x
+
+
+def _rated(scene: Scene, torque: float | None) -> float:
+    if torque is not None:
+        return _float("torque", torque, "N m")
+    load = scene["load"]
+    if isinstance(load, dict) and load.get("kind") == "constant":
+        return float(load["torque"])
+    raise ParameterError("give the torque [N m]: the scene's load is not a constant torque")
+
+
+@dataclass(frozen=True)
+class LtcaResult:
+    """Static equilibria at a set of crank angles under one output torque.
+
+    Arrays (SI): ``crank_angle`` (n,) [rad]; ``output_angle``, ``input_angle``,
+    ``transmission_error`` (output minus input/ratio), ``input_torque`` (n,) [rad, rad, rad,
+    N m]; per disc and pin ``pin_force``, ``pin_gap``, ``half_width``, ``peak_pressure``
+    (n, discs, pins) [N, m, m, Pa]; ``contact_point``, ``contact_normal`` (n, discs, pins, 2)
+    in the disc frame [m, -]; ``loaded_pins`` (n, discs); ``disc_rotation`` (n, discs) [rad];
+    ``disc_displacement`` (n, discs, 2) [m]; ``mesh_force`` (n, cranks) [N];
+    ``crank_bearing_force`` (n, cranks, 2) and ``eccentric_bearing_force`` (n, cranks, discs, 2)
+    [N] (empty for rigid joints); ``torque_balance``, ``residual`` (n,) relative;
+    ``iterations`` (n,); ``torsional_stiffness`` (n,) [N m/rad].
+    """
+
+    torque: float
+    mesh_period: float
+    ratio: float
+    face_width: float
+    arrays: dict[str, np.ndarray] = field(repr=False)
+    fea_csv: str = field(repr=False)
+    fea_json: str = field(repr=False)
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        arrays = object.__getattribute__(self, "arrays")
+        if name in arrays:
+            value: np.ndarray = arrays[name]
+            return value
+        raise AttributeError(name)
+
+    @property
+    def peak_pin_force(self) -> float:
+        """Largest pin force over all crank angles and discs [N]."""
+        return float(np.max(self.arrays["pin_force"])) if self.arrays["pin_force"].size else 0.0
+
+    def summary(self) -> dict[str, Any]:
+        """Peak pin force [N], loaded pins per disc (min, max), TE peak-to-peak [rad], worst
+        torque balance and residual."""
+        a = self.arrays
+        return {
+            "torque_Nm": self.torque,
+            "crank_angles": int(a["crank_angle"].size),
+            "peak_pin_force_N": self.peak_pin_force,
+            "loaded_pins_min": int(a["loaded_pins"].min()),
+            "loaded_pins_max": int(a["loaded_pins"].max()),
+            "te_peak_to_peak_rad": float(np.ptp(a["transmission_error"])),
+            "torque_balance_max": float(a["torque_balance"].max()),
+            "residual_max": float(a["residual"].max()),
+            "peak_pressure_max_Pa": float(a["peak_pressure"].max()),
+        }
+
+    def worst_index(self, disc: int = 0) -> int:
+        """Index of the crank angle with the largest pin force on ``disc``."""
+        return int(np.argmax(self.arrays["pin_force"][:, disc, :].max(axis=1)))
+
+    def save_fea_loads(self, folder: str | Path) -> tuple[Path, Path]:
+        """Write ``fea_loads.csv`` and ``fea_loads.json`` (format: docs/model.md, "Loads for
+        FEA") into ``folder``; returns their paths."""
+        out = Path(folder)
+        out.mkdir(parents=True, exist_ok=True)
+        csv_path, json_path = out / "fea_loads.csv", out / "fea_loads.json"
+        csv_path.write_text(self.fea_csv)
+        json_path.write_text(self.fea_json)
+        return csv_path, json_path
+
+    def plot_load_distribution(self, index: int | None = None, polar: bool = True,
+                               ax: Axes | None = None) -> Figure:
+        """Pin forces of both discs at crank angle ``index`` (default: the worst one), polar
+        (pin positions around the ring) or as bars."""
+        from ..plotting import new_figure
+
+        i = self.worst_index() if index is None else int(index)
+        f = self.arrays["pin_force"][i]
+        nd, zp = f.shape
+        if ax is None:
+            if polar:
+                from matplotlib.figure import Figure
+
+                fig = Figure(figsize=(6.5, 6.5), layout="constrained")
+                ax = fig.add_subplot(projection="polar")
+            else:
+                fig, ax = new_figure((8.0, 4.5))
+        else:
+            fig = ax.figure  # type: ignore[assignment]
+        theta = 2.0 * np.pi * np.arange(zp) / zp
+        for k in range(nd):
+            if polar:
+                ax.plot(np.append(theta, theta[0]), np.append(f[k], f[k][0]) / 1e3, marker="o",
+                        label=f"disc {k}")
+            else:
+                w = 0.8 / nd
+                ax.bar(np.arange(1, zp + 1) + (k - (nd - 1) / 2) * w, f[k] / 1e3, width=w,
+                       label=f"disc {k}")
+        if not polar:
+            ax.set_xlabel("pin (the paper's numbering)")
+            ax.set_ylabel("pin force [kN]")
+        ax.set_title(f"pin forces [kN], crank angle {math.degrees(self.arrays['crank_angle'][i]):.2f} deg, "
+                     f"T = {self.torque / 1e3:.2f} kN m")
+        ax.legend()
+        return fig
+
+    def plot_contact_pressure(self, ax: Axes | None = None) -> Figure:
+        """Largest Hertz peak pressure of each pin over the crank angles [MPa], per disc."""
+        from ..plotting import new_figure
+
+        fig, ax = new_figure((8.0, 4.5)) if ax is None else (ax.figure, ax)
+        p = self.arrays["peak_pressure"].max(axis=0) / 1e6
+        for k in range(p.shape[0]):
+            ax.plot(np.arange(1, p.shape[1] + 1), p[k], marker="o", label=f"disc {k}")
+        ax.set_xlabel("pin (the paper's numbering)")
+        ax.set_ylabel("Hertz peak pressure, max over crank angles [MPa]")
+        ax.set_title(f"contact pressure, T = {self.torque / 1e3:.2f} kN m")
+        ax.legend()
+        return fig  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class TransmissionError:
+    """TE over one mesh period, forward (+torque) and reverse (-torque), loaded and at a light
+    load (unloaded) [rad]; ``crank_angle`` [rad], ``period`` [rad]."""
+
+    crank_angle: np.ndarray
+    period: float
+    forward: np.ndarray
+    reverse: np.ndarray
+    unloaded_forward: np.ndarray
+    unloaded_reverse: np.ndarray
+    torque: float
+    light: float
+
+    def peak_to_peak(self) -> dict[str, float]:
+        """Peak-to-peak of each curve [rad]."""
+        return {k: float(np.ptp(getattr(self, k))) for k in
+                ("forward", "reverse", "unloaded_forward", "unloaded_reverse")}
+
+    def lost_motion(self) -> np.ndarray:
+        """Difference of the reverse and forward TE at each crank angle [rad] (the lost motion
+        at this torque)."""
+        diff: np.ndarray = self.reverse - self.forward
+        return diff
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """TE in arcsec about its mean, both directions, loaded and unloaded."""
+        from ..plotting import new_figure
+
+        fig, ax = new_figure((8.0, 4.5)) if ax is None else (ax.figure, ax)
+        x = np.degrees(self.crank_angle)
+        for name, style in (("forward", "-"), ("reverse", "-"), ("unloaded_forward", "--"),
+                            ("unloaded_reverse", "--")):
+            y = getattr(self, name)
+            ax.plot(x, (y - y.mean()) / ARCSEC, style,
+                    label=f"{name.replace('_', ' ')} (mean {y.mean() / ARCMIN:+.2f} arcmin)")
+        ax.set_xlabel("crank angle [deg] (one mesh period)")
+        ax.set_ylabel("TE about its mean [arcsec]")
+        ax.set_title(f"transmission error, T = +-{self.torque / 1e3:.2f} kN m")
+        ax.legend(fontsize="small")
+        return fig  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class TwistLoop:
+    """The torque-twist loop at one crank angle: ``torque`` [N m], ``twist`` [rad] (positive
+    with positive torque), ``tangent_stiffness`` [N m/rad]; catalogue ``rigidity`` [N m/rad],
+    ``lost_motion`` and ``backlash`` [rad] (docs/model.md, "Torque-twist loop")."""
+
+    crank_angle: float
+    rated_torque: float
+    torque: np.ndarray
+    twist: np.ndarray
+    tangent_stiffness: np.ndarray
+    rigidity: float
+    lost_motion: float
+    backlash: float
+
+    def summary(self) -> dict[str, float]:
+        """Rigidity [N m/arcmin], lost motion and backlash [arcmin]."""
+        return {
+            "rigidity_Nm_per_arcmin": self.rigidity * ARCMIN,
+            "lost_motion_arcmin": self.lost_motion / ARCMIN,
+            "backlash_arcmin": self.backlash / ARCMIN,
+        }
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The hysteresis loop: twist [arcmin] against torque [kN m]."""
+        from ..plotting import new_figure
+
+        fig, ax = new_figure((6.5, 5.0)) if ax is None else (ax.figure, ax)
+        ax.plot(self.twist / ARCMIN, self.torque / 1e3, marker=".")
+        ax.axhline(0.0, color="0.7", lw=0.8)
+        ax.axvline(0.0, color="0.7", lw=0.8)
+        s = self.summary()
+        ax.set_xlabel("output twist [arcmin]")
+        ax.set_ylabel("output torque [kN m]")
+        ax.set_title(f"torque-twist: rigidity {s['rigidity_Nm_per_arcmin']:.0f} N m/arcmin, "
+                     f"lost motion {s['lost_motion_arcmin']:.3f}', backlash {s['backlash_arcmin']:.3f}'")
+        return fig  # type: ignore[return-value]
+
+
+def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float] | np.ndarray | None = None,
+         *, tolerance: float = 1e-12, progress: Callable[[int, int], None] | None = None,
+         chunk: int = 360) -> LtcaResult:
+    """Loaded tooth contact analysis of ``scene`` under the output ``torque`` [N m] (default:
+    the scene's constant load) at ``crank_angles`` [rad] (default: 90 angles over one mesh
+    period), each equilibrium warm-started from the previous.
+
+    Raises ``ConvergenceError`` (naming the crank angle and residual) when no equilibrium is
+    found, ``ParameterError`` for non-finite input.
+    """
+    sc = _scene(scene)
+    t = _rated(sc, torque)
+    if crank_angles is None:
+        period = float(_core.LtcaSolver(sc._compiled, 1e-12).mesh_period)
+        angles = period * np.arange(90) / 90.0
+    else:
+        angles = np.atleast_1d(np.asarray(crank_angles, dtype=float))
+    if angles.ndim != 1 or angles.size == 0:
+        raise ParameterError(f"crank_angles must be a non-empty 1-D array [rad], got shape {angles.shape}")
+    if not np.all(np.isfinite(angles)):
+        raise ParameterError("crank_angles must be finite numbers [rad]")
+    tol = _float("tolerance", tolerance, "-")
+    solver = _core.LtcaSolver(sc._compiled, tol)
+    parts: list[dict[str, np.ndarray]] = []
+    step = max(int(chunk), 1)
+    for start in range(0, angles.size, step):
+        # The solver keeps its warm start and its points across chunks.
+        parts.append(solver.sweep(t, angles[start:start + step].tolist()))
+        if progress is not None:
+            progress(min(start + step, angles.size), angles.size)
+    arrays = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+    fea_csv, fea_json = solver.fea_loads()
+    return LtcaResult(torque=t, mesh_period=float(solver.mesh_period), ratio=float(solver.ratio),
+                      face_width=float(solver.face_width), arrays=arrays, fea_csv=fea_csv,
+                      fea_json=fea_json)
+
+
+def transmission_error(scene: Scene, torque: float | None = None, points: int = 90, *,
+                       light: float | None = None, start: float = 0.0) -> TransmissionError:
+    """TE over one mesh period at ``points`` crank angles, at ``+-torque`` and at the light load
+    ``+-light`` [N m] (default ``1e-6 torque``) from crank angle ``start`` [rad]."""
+    sc = _scene(scene)
+    t = abs(_rated(sc, torque))
+    lt = 1e-6 * t if light is None else abs(_float("light", light, "N m"))
+    d = _core.LtcaSolver(sc._compiled, 1e-12).transmission_error(t, lt, int(points),
+                                                                 _float("start", start, "rad"))
+    return TransmissionError(crank_angle=d["crank_angle"], period=float(d["period"]),
+                             forward=d["forward"], reverse=d["reverse"],
+                             unloaded_forward=d["unloaded_forward"],
+                             unloaded_reverse=d["unloaded_reverse"], torque=t, light=lt)
+
+
+def torque_twist(scene: Scene, rated_torque: float | None = None, crank_angle: float = 0.0,
+                 points: int = 201) -> TwistLoop:
+    """The torque-twist loop 0 -> +rated -> -rated -> 0 at ``crank_angle`` [rad] with the input
+    held, with rigidity, lost motion and backlash (catalogue definitions)."""
+    sc = _scene(scene)
+    t = abs(_rated(sc, rated_torque))
+    d = _core.LtcaSolver(sc._compiled, 1e-12).twist_loop(t, _float("crank_angle", crank_angle, "rad"),
+                                                         int(points))
+    return TwistLoop(crank_angle=float(crank_angle), rated_torque=t, torque=d["torque"],
+                     twist=d["twist"], tangent_stiffness=d["tangent_stiffness"],
+                     rigidity=float(d["rigidity"]), lost_motion=float(d["lost_motion"]),
+                     backlash=float(d["backlash"]))

@@ -1,0 +1,622 @@
+//! Loaded tooth contact analysis (LTCA): the static equilibrium of the whole reducer under an
+//! output torque with the input held, at a set of crank angles; transmission error in both
+//! drive directions, the torque-twist loop with rigidity, lost motion and backlash, and the
+//! worst-case contact loads for FEA (formulation and sources: docs/model.md, "Quasi-static
+//! analysis").
+//!
+//! Crank angle `psi` [rad]: the absolute crank rotation of the kinematic (unloaded, error-free)
+//! pose, in which the carrier is at `-psi / zc`, disc `k`'s centre at
+//! `e (cos(psi + a_k), sin(psi + a_k))` and the input (sun, or cranks without a first stage)
+//! where the first stage has no deflection. The input is held there; the output torque `T`
+//! [N m] acts on the carrier against positive rotation (as the scene's load), so a positive
+//! `T` is the forward drive.
+
+pub mod export;
+pub mod newton;
+pub mod statics;
+
+use std::f64::consts::{PI, TAU};
+
+use crate::contact::hertz::{Material, hertz_line_contact};
+use crate::dynamics::scene::Scene;
+use crate::error::{Result, RvdynError, require_finite};
+pub use newton::{NewtonOptions, NewtonReport};
+use newton::{equilibrium, solve_dense};
+use serde::Serialize;
+use statics::{CARRIER, ContactState, Dense, Statics, Work};
+
+/// One arc minute [rad].
+pub const ARCMIN: f64 = PI / (180.0 * 60.0);
+/// One arc second [rad].
+pub const ARCSEC: f64 = PI / (180.0 * 3600.0);
+
+/// One pin contact at equilibrium (disc frame: origin at the disc centre, axes turned with the
+/// disc).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PinLoad {
+    /// Normal force [N] (>= 0).
+    pub force: f64,
+    /// Signed gap [m] (negative = penetration).
+    pub gap: f64,
+    /// Contact point on the profile, disc frame [m].
+    pub point: [f64; 2],
+    /// Unit outward profile normal, disc frame.
+    pub normal: [f64; 2],
+    /// Hertz half-width of the contact strip [m] (0 without load).
+    pub half_width: f64,
+    /// Hertz peak pressure [Pa] (0 without load).
+    pub peak_pressure: f64,
+}
+
+/// The static equilibrium at one crank angle and torque.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LtcaPoint {
+    /// Crank angle [rad].
+    pub crank_angle: f64,
+    /// Output torque [N m].
+    pub torque: f64,
+    /// Carrier (output) angle [rad].
+    pub output_angle: f64,
+    /// Held input angle [rad].
+    pub input_angle: f64,
+    /// Transmission error `output - input / i` [rad].
+    pub transmission_error: f64,
+    /// Torque the held input carries [N m].
+    pub input_torque: f64,
+    /// Pin loads, `[disc][pin]`.
+    pub pins: Vec<Vec<PinLoad>>,
+    /// Loaded pins per disc.
+    pub loaded_pins: Vec<usize>,
+    /// Disc rotation from its kinematic angle [rad], per disc.
+    pub disc_rotation: Vec<f64>,
+    /// Disc centre displacement from its kinematic position [m], per disc.
+    pub disc_displacement: Vec<[f64; 2]>,
+    /// Signed sun/planet mesh force per crank [N] (positive on the drive flank).
+    pub mesh_force: Vec<f64>,
+    /// Crank bearing force on each crank centre [N] (compliant crank bearings; else empty).
+    pub crank_bearing_force: Vec<[f64; 2]>,
+    /// Eccentric bearing force on each disc, `[crank * discs + disc]` [N] (compliant joints).
+    pub eccentric_bearing_force: Vec<[f64; 2]>,
+    /// Moment balance of the whole reducer about its axis (input + load + pin reactions),
+    /// relative to the torque.
+    pub torque_balance: f64,
+    /// Largest residual of the equilibrium equations (every free coordinate of every body),
+    /// relative to the load scale.
+    pub residual: f64,
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// Torsional stiffness `dT / d(output angle)` at this equilibrium [N m/rad], analytic.
+    pub torsional_stiffness: f64,
+}
+
+impl LtcaPoint {
+    /// Largest pin force [N] over both discs.
+    pub fn peak_pin_force(&self) -> f64 {
+        self.pins
+            .iter()
+            .flatten()
+            .fold(0.0, |m: f64, p| m.max(p.force))
+    }
+}
+
+/// Transmission error over one mesh period in both drive directions.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TransmissionError {
+    /// Crank angles [rad] (one full mesh period, endpoint excluded).
+    pub crank_angle: Vec<f64>,
+    /// Period of the mesh in crank angle [rad].
+    pub period: f64,
+    /// TE at `+torque` (forward drive) [rad].
+    pub forward: Vec<f64>,
+    /// TE at `-torque` (reverse drive) [rad].
+    pub reverse: Vec<f64>,
+    /// TE at the light load `+light` [rad]: the geometric (unloaded) TE, forward.
+    pub unloaded_forward: Vec<f64>,
+    /// TE at `-light` [rad]: the unloaded TE, reverse.
+    pub unloaded_reverse: Vec<f64>,
+    /// Loaded torque [N m].
+    pub torque: f64,
+    /// Light torque of the unloaded TE [N m].
+    pub light: f64,
+}
+
+/// Peak-to-peak of a series.
+pub fn peak_to_peak(v: &[f64]) -> f64 {
+    let (lo, hi) = v
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(*x), b.max(*x))
+        });
+    if v.is_empty() { 0.0 } else { hi - lo }
+}
+
+/// The torque-twist loop at one crank angle with rigidity, lost motion and backlash.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TwistLoop {
+    /// Crank angle of the loop [rad].
+    pub crank_angle: f64,
+    /// Output torque along the loop [N m] (0 -> +rated -> -rated -> 0).
+    pub torque: Vec<f64>,
+    /// Output twist relative to the held input [rad] (positive with positive torque).
+    pub twist: Vec<f64>,
+    /// Rated torque of the loop [N m].
+    pub rated_torque: f64,
+    /// Catalogue torsional rigidity `2 T_r / (twist(+T_r) - twist(-T_r))` [N m/rad].
+    pub rigidity: f64,
+    /// Lost motion: twist width between the loop's midpoints at +-3 % of rated torque [rad].
+    pub lost_motion: f64,
+    /// Backlash: twist width at zero torque (limits from both sides) [rad].
+    pub backlash: f64,
+    /// Analytic tangent stiffness at each loop point [N m/rad].
+    pub tangent_stiffness: Vec<f64>,
+}
+
+/// A solved equilibrium kept for warm starts.
+#[derive(Debug, Clone)]
+struct Solved {
+    psi: f64,
+    torque: f64,
+    q: Vec<f64>,
+}
+
+/// The loaded tooth contact analysis of one scene.
+#[derive(Debug, Clone)]
+pub struct Ltca {
+    statics: Statics,
+    options: NewtonOptions,
+    work: Work,
+    /// Last solution `(psi, q)`: the warm start of the next.
+    last: Option<Solved>,
+    /// The solution before the last: with the last, a linear predictor.
+    before: Option<Solved>,
+    k_ref: f64,
+    face_width: f64,
+    ratio: f64,
+    mesh_period: f64,
+}
+
+impl Ltca {
+    /// Build the analysis of a scene (validated; its drive and load are ignored: the input is
+    /// held and the torque is given per call).
+    pub fn new(scene: &Scene) -> Result<Self> {
+        Self::with_options(scene, NewtonOptions::default())
+    }
+
+    /// As [`Ltca::new`] with solver options.
+    pub fn with_options(scene: &Scene, options: NewtonOptions) -> Result<Self> {
+        require_finite("tolerance", options.tolerance)?;
+        let statics = Statics::new(scene)?;
+        let law = statics.pin_law;
+        let (f, _) = statics::elastic(&law, 1e-5);
+        let mut k_ref = f / 1e-5;
+        if let Some(b) = &statics.eccentric_bearing {
+            // The bearing's stiffness at a 1 mm deflection (beyond any clearance it has).
+            k_ref = k_ref.max(b.static_tangent([1e-3, 0.0]).1[0][0]);
+        }
+        Ok(Self {
+            options,
+            work: Work::new(),
+            last: None,
+            before: None,
+            k_ref,
+            face_width: scene.cycloid.face_width,
+            ratio: scene.ratio(),
+            mesh_period: mesh_period(scene),
+            statics,
+        })
+    }
+
+    /// Period of the mesh in crank angle [rad] (see [`mesh_period`]).
+    pub fn mesh_period(&self) -> f64 {
+        self.mesh_period
+    }
+
+    /// Transmission ratio input/output.
+    pub fn ratio(&self) -> f64 {
+        self.ratio
+    }
+
+    /// The unknowns of the last equilibrium found (empty before the first).
+    pub fn last_unknowns(&self) -> &[f64] {
+        self.last.as_ref().map_or(&[], |s| &s.q)
+    }
+
+    /// Forget the warm start.
+    pub fn reset(&mut self) {
+        self.last = None;
+        self.before = None;
+    }
+
+    /// The equilibrium unknowns at `psi` and `torque`, warm-started from the last solution
+    /// (its deflection carried to the new kinematic pose). Returns them with the report.
+    pub(crate) fn solve_unknowns(
+        &mut self,
+        torque: f64,
+        psi: f64,
+    ) -> Result<(Vec<f64>, NewtonReport)> {
+        require_finite("torque", torque)?;
+        require_finite("crank angle", psi)?;
+        let st = &mut self.statics;
+        let kin = st.kinematic_unknowns(psi);
+        // Warm start: the last solution's deflection from its kinematic pose carried to this
+        // one; with two previous solutions along the same torque (or the same crank angle),
+        // extrapolated linearly in the crank angle (or the torque).
+        let deflection = |p: &Solved, st: &Statics| -> Vec<f64> {
+            let k = st.kinematic_unknowns(p.psi);
+            p.q.iter().zip(&k).map(|(a, b)| a - b).collect()
+        };
+        let mut q = match (&self.last, &self.before) {
+            (Some(l), Some(b)) => {
+                let d1 = deflection(l, st);
+                let d0 = deflection(b, st);
+                let w = if l.torque == torque && b.torque == torque && l.psi != b.psi {
+                    (psi - l.psi) / (l.psi - b.psi)
+                } else if l.psi == psi && b.psi == psi && l.torque != b.torque {
+                    (torque - l.torque) / (l.torque - b.torque)
+                } else {
+                    0.0
+                };
+                // Only interpolate or extrapolate one step ahead (a far jump is no predictor).
+                let w = if w.abs() <= 1.5 { w } else { 0.0 };
+                kin.iter()
+                    .zip(d1.iter().zip(&d0))
+                    .map(|(k, (a, b))| k + a + w * (a - b))
+                    .collect()
+            }
+            (Some(l), None) => {
+                let d1 = deflection(l, st);
+                kin.iter().zip(&d1).map(|(k, a)| k + a).collect()
+            }
+            _ => kin,
+        };
+        let rep = match equilibrium(
+            st,
+            psi,
+            torque,
+            &mut q,
+            self.k_ref,
+            &self.options,
+            &mut self.work,
+        ) {
+            Ok(r) => r,
+            Err(e) if self.last.is_some() => {
+                // A warm start from far away can be worse than the kinematic pose.
+                let _ = e;
+                let mut q2 = st.kinematic_unknowns(psi);
+                let r = equilibrium(
+                    st,
+                    psi,
+                    torque,
+                    &mut q2,
+                    self.k_ref,
+                    &self.options,
+                    &mut self.work,
+                )?;
+                q = q2;
+                r
+            }
+            Err(e) => return Err(e),
+        };
+        self.before = self.last.take();
+        self.last = Some(Solved {
+            psi,
+            torque,
+            q: q.clone(),
+        });
+        Ok((q, rep))
+    }
+
+    /// The static equilibrium at crank angle `psi` [rad] under the output torque `torque`
+    /// [N m]. Errors: non-finite input (`Parameter`); no equilibrium found or a penetration
+    /// beyond a tenth of the pin radius (`Convergence`, naming the crank angle and residual).
+    pub fn solve(&mut self, torque: f64, psi: f64) -> Result<LtcaPoint> {
+        let (q, rep) = self.solve_unknowns(torque, psi)?;
+        self.point(torque, psi, &q, rep)
+    }
+
+    /// Equilibria at each crank angle in turn (each warm-started from the previous).
+    pub fn sweep(&mut self, torque: f64, crank_angles: &[f64]) -> Result<Vec<LtcaPoint>> {
+        crank_angles
+            .iter()
+            .map(|&p| self.solve(torque, p))
+            .collect()
+    }
+
+    /// Output angle at equilibrium only (no contact details): the fast path of TE and loops.
+    fn output_angle(&mut self, torque: f64, psi: f64) -> Result<(f64, f64)> {
+        let (q, _) = self.solve_unknowns(torque, psi)?;
+        let st = &self.statics;
+        let x = st.full(psi, &q);
+        let kin = -psi / st.zc();
+        Ok((x[CARRIER], x[CARRIER] - kin))
+    }
+
+    /// Analytic torsional stiffness `dT / d(output angle)` [N m/rad] at the last equilibrium
+    /// found: `1 / (K^-1)_00` (the output angle is unknown 0; the load enters as `-T e_0`).
+    fn last_tangent_stiffness(&mut self) -> f64 {
+        let mut k = self.work.k_last.clone();
+        let mut e0 = vec![0.0; k.n];
+        if k.n == 0 {
+            return 0.0;
+        }
+        e0[0] = 1.0;
+        if !solve_dense(&mut k, &mut e0) || e0[0] <= 0.0 {
+            return 0.0;
+        }
+        1.0 / e0[0]
+    }
+
+    fn point(&mut self, torque: f64, psi: f64, q: &[f64], rep: NewtonReport) -> Result<LtcaPoint> {
+        let st = &mut self.statics;
+        let n = st.dim();
+        let mut r = vec![0.0; n];
+        let mut k = Dense::zeros(n);
+        let mut cs = ContactState::default();
+        // Fresh gaps of every pin for the report (no separation skipping).
+        st.exact = true;
+        let evaluated = st.eval(
+            psi,
+            q,
+            torque,
+            &mut r,
+            &mut k,
+            &mut self.work,
+            Some(&mut cs),
+        );
+        st.exact = false;
+        evaluated?;
+        let mut e0 = vec![0.0; n];
+        e0[0] = 1.0;
+        let stiff = if solve_dense(&mut k, &mut e0) && e0[0] > 0.0 {
+            1.0 / e0[0]
+        } else {
+            0.0
+        };
+        let x = st.full(psi, q);
+        let kin = st.kinematic_full(psi);
+        let m = &st.model;
+        let zp = m.pins.len();
+        let steel = Material::steel();
+        let mut pins = Vec::with_capacity(m.discs.len());
+        let mut loaded = Vec::new();
+        let mut rot = Vec::new();
+        let mut disp = Vec::new();
+        let mut pin_moment = 0.0;
+        let max_pen = m.max_penetration;
+        for (kd, _) in m.discs.iter().enumerate() {
+            let dk = st.disc_index(kd);
+            let th = x[dk + 2];
+            let (s, c) = th.sin_cos();
+            let to_disc = |v: [f64; 2]| [c * v[0] + s * v[1], -s * v[0] + c * v[1]];
+            let mut row = Vec::with_capacity(zp);
+            let mut count = 0;
+            for j in 0..zp {
+                let jet = &cs.pin_jet[kd * zp + j];
+                let f = cs.pin_force[kd * zp + j];
+                if -jet.gap > max_pen {
+                    return Err(RvdynError::Convergence(format!(
+                        "at crank angle {psi:.6} rad and torque {torque:.6e} N m pin {} on disc \
+                         {kd} penetrates {:.3e} m, beyond a tenth of the pin radius: the contact \
+                         law cannot carry this torque with the contact geometry intact; reduce \
+                         the torque or use a stiffer contact law",
+                        j + 1,
+                        -jet.gap
+                    )));
+                }
+                let (hw, p0) = if f > 0.0 {
+                    hertz_line_contact(
+                        f,
+                        self.face_width,
+                        m.pins[j].radius,
+                        jet.curvature_radius,
+                        &steel,
+                        &steel,
+                    )
+                    .map_or((0.0, 0.0), |h| (h.half_width, h.peak_pressure))
+                } else {
+                    (0.0, 0.0)
+                };
+                if f > 0.0 {
+                    count += 1;
+                }
+                // Moment about the reducer axis of the pin's force -f N on the disc.
+                let point = [x[dk] + jet.arm[0], x[dk + 1] + jet.arm[1]];
+                pin_moment -= f * (point[0] * jet.normal[1] - point[1] * jet.normal[0]);
+                row.push(PinLoad {
+                    force: f,
+                    gap: jet.gap,
+                    point: to_disc(jet.arm),
+                    normal: to_disc(jet.normal),
+                    half_width: hw,
+                    peak_pressure: p0,
+                });
+            }
+            pins.push(row);
+            loaded.push(count);
+            rot.push(th - kin[dk + 2]);
+            disp.push([x[dk] - kin[dk], x[dk + 1] - kin[dk + 1]]);
+        }
+        let input_torque = st.input_reaction(&self.work);
+        let balance = (input_torque - torque + pin_moment).abs() / torque.abs().max(1.0);
+        let input_angle = if m.mesh.is_some() {
+            st.held_input(psi)
+        } else {
+            psi
+        };
+        Ok(LtcaPoint {
+            crank_angle: psi,
+            torque,
+            output_angle: x[CARRIER],
+            input_angle,
+            transmission_error: x[CARRIER] - input_angle / self.ratio,
+            input_torque,
+            pins,
+            loaded_pins: loaded,
+            disc_rotation: rot,
+            disc_displacement: disp,
+            mesh_force: cs.mesh_force,
+            crank_bearing_force: cs.crank_bearing_force,
+            eccentric_bearing_force: cs.eccentric_bearing_force,
+            torque_balance: balance,
+            residual: rep.residual,
+            iterations: rep.iterations,
+            torsional_stiffness: stiff,
+        })
+    }
+
+    /// Transmission error over one mesh period at `points` crank angles, at `+-torque`
+    /// (loaded) and `+-light` (unloaded: a light load that keeps the flanks in contact, as in
+    /// single-flank testing) [N m].
+    pub fn transmission_error(
+        &mut self,
+        torque: f64,
+        light: f64,
+        points: usize,
+        start: f64,
+    ) -> Result<TransmissionError> {
+        require_finite("start", start)?;
+        if points < 2 {
+            return Err(RvdynError::Parameter(format!(
+                "transmission error needs at least 2 crank angles per period, got {points}"
+            )));
+        }
+        let period = self.mesh_period;
+        let angles: Vec<f64> = (0..points)
+            .map(|i| start + period * i as f64 / points as f64)
+            .collect();
+        let mut run = |t: f64| -> Result<Vec<f64>> {
+            self.reset();
+            angles
+                .iter()
+                .map(|&p| {
+                    let (out, _) = self.output_angle(t, p)?;
+                    let input = if self.statics.model.mesh.is_some() {
+                        self.statics.held_input(p)
+                    } else {
+                        p
+                    };
+                    Ok(out - input / self.ratio)
+                })
+                .collect()
+        };
+        let forward = run(torque.abs())?;
+        let reverse = run(-torque.abs())?;
+        let unloaded_forward = run(light.abs())?;
+        let unloaded_reverse = run(-light.abs())?;
+        Ok(TransmissionError {
+            crank_angle: angles,
+            period,
+            forward,
+            reverse,
+            unloaded_forward,
+            unloaded_reverse,
+            torque: torque.abs(),
+            light: light.abs(),
+        })
+    }
+
+    /// The torque-twist loop at crank angle `psi`: `points` torques along
+    /// 0 -> +rated -> -rated -> 0 with rigidity, lost motion and backlash (catalogue
+    /// definitions, docs/model.md).
+    pub fn twist_loop(&mut self, rated: f64, psi: f64, points: usize) -> Result<TwistLoop> {
+        require_finite("rated torque", rated)?;
+        let rated = rated.abs();
+        if rated == 0.0 || points < 8 {
+            return Err(RvdynError::Parameter(format!(
+                "the torque-twist loop needs a rated torque > 0 N m and at least 8 points, got \
+                 {rated} N m and {points}"
+            )));
+        }
+        // Parameter s in [0, 4): 0 -> 1 -> -1 -> 0 piecewise linear.
+        let torque: Vec<f64> = (0..points)
+            .map(|i| {
+                let s = 4.0 * i as f64 / (points - 1) as f64;
+                let v = if s <= 1.0 {
+                    s
+                } else if s <= 3.0 {
+                    2.0 - s
+                } else {
+                    s - 4.0
+                };
+                rated * v
+            })
+            .collect();
+        self.reset();
+        let mut twist = Vec::with_capacity(points);
+        let mut tangent = Vec::with_capacity(points);
+        // At zero torque the equilibrium is any pose inside the clearances: the loop takes the
+        // limit along its branch (a torque of 1e-7 rated on the side it comes from; the elastic
+        // twist at that torque is ~(1e-7)^(2/3) = 2e-5 of the rated one for Hertz contacts).
+        let eps = 1e-7 * rated;
+        let mut side = 1.0;
+        let mut solved: Vec<(f64, Vec<f64>)> = Vec::with_capacity(points);
+        for &t in &torque {
+            let ts = if t == 0.0 { side * eps } else { t };
+            if t != 0.0 {
+                side = t.signum();
+            }
+            let (q, _) = self.solve_unknowns(ts, psi)?;
+            solved.push((ts, q.clone()));
+            let x = self.statics.full(psi, &q);
+            // Twist positive with positive torque: the load turns the output backwards.
+            twist.push(-(x[CARRIER] + psi / self.statics.zc()));
+            tangent.push(self.last_tangent_stiffness());
+        }
+        // The catalogue points, each warm-started from the loop point nearest in torque on the
+        // same side of zero.
+        let mut at = |t: f64| -> Result<f64> {
+            self.reset();
+            if let Some((t0, q0)) = solved
+                .iter()
+                .filter(|(s, _)| s.signum() == t.signum())
+                .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+            {
+                self.last = Some(Solved {
+                    psi,
+                    torque: *t0,
+                    q: q0.clone(),
+                });
+            }
+            let (_, dev) = self.output_angle(t, psi)?;
+            Ok(-dev)
+        };
+        let rigidity = 2.0 * rated / (at(rated)? - at(-rated)?);
+        let lost_motion = at(0.03 * rated)? - at(-0.03 * rated)?;
+        let backlash = at(eps)? - at(-eps)?;
+        let _ = side;
+        Ok(TwistLoop {
+            crank_angle: psi,
+            torque,
+            twist,
+            rated_torque: rated,
+            rigidity,
+            lost_motion,
+            backlash,
+            tangent_stiffness: tangent,
+        })
+    }
+}
+
+/// The crank-angle period after which the whole contact pattern repeats [rad].
+///
+/// Turning the crank by `2 pi / zp` turns the disc by `-2 pi / (zp zc)`; the assembly then is
+/// the old one rotated by `2 pi / zp` about the axis (pin `j` takes the place of pin `j - 1`)
+/// with the disc turned by one lobe pitch `-2 pi / zc`, which the profile cannot tell. So with
+/// identical pins the pattern repeats every `2 pi / zp` of crank angle (both discs at once:
+/// their phases only shift the pattern). Pin errors make pins distinguishable: a pin returns to
+/// the same lobe position only after the shift is a whole number of rings, `2 pi` of crank
+/// angle. (The first stage's mesh law does not vary with the tooth position in the scene's
+/// laws, so it adds no period.)
+pub fn mesh_period(scene: &Scene) -> f64 {
+    let e = &scene.pin_errors;
+    let errors =
+        e.position.iter().any(|p| p[0] != 0.0 || p[1] != 0.0) || e.radius.iter().any(|r| *r != 0.0);
+    if errors {
+        TAU
+    } else {
+        TAU / f64::from(scene.cycloid.pins)
+    }
+}
+
+#[cfg(test)]
+mod tests;

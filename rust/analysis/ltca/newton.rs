@@ -1,0 +1,328 @@
+//! Damped Newton on the static equilibrium `Q(q) = 0` with the exact tangent `K = -dQ/dq`.
+//!
+//! Each iteration solves `(K + mu D) dq = Q` (Levenberg-Marquardt: `mu = 0`, plain Newton,
+//! whenever that step is acceptable; `D = diag(k_ref L_a^2)` with `L_a` the length of unknown
+//! `a` and `k_ref` a reference contact stiffness) and backtracks along `dq` until the scaled
+//! residual norm decreases (Armijo condition; Nocedal and Wright, *Numerical Optimization*,
+//! 2nd ed., 2006, sections 3.1 and 10.3). `mu` is raised tenfold when no step along the
+//! direction decreases the residual (or `K` is singular, as at first touch of a Hertz law,
+//! whose stiffness is zero at zero penetration) and lowered tenfold after each accepted step.
+//! Contacts that open or close need no active set: a contact law is zero (with zero
+//! derivative) for a positive gap.
+
+#![allow(clippy::needless_range_loop)]
+
+use crate::analysis::ltca::statics::{Dense, Statics, Work};
+use crate::error::{Result, RvdynError};
+
+/// Solve `a x = b` in place (`b` becomes `x`) by Gaussian elimination with partial pivoting;
+/// `a` is destroyed. Returns false if a pivot is below `1e-14` times the largest entry.
+pub fn solve_dense(a: &mut Dense, b: &mut [f64]) -> bool {
+    let n = a.n;
+    let amax = a.a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if amax == 0.0 || !amax.is_finite() {
+        return false;
+    }
+    for c in 0..n {
+        let mut p = c;
+        for r in c + 1..n {
+            if a.at(r, c).abs() > a.at(p, c).abs() {
+                p = r;
+            }
+        }
+        if a.at(p, c).abs() <= 1e-14 * amax {
+            return false;
+        }
+        if p != c {
+            for j in 0..n {
+                a.a.swap(c * n + j, p * n + j);
+            }
+            b.swap(c, p);
+        }
+        let piv = a.at(c, c);
+        for r in c + 1..n {
+            let f = a.at(r, c) / piv;
+            if f != 0.0 {
+                for j in c..n {
+                    a.a[r * n + j] -= f * a.a[c * n + j];
+                }
+                b[r] -= f * b[c];
+            }
+        }
+    }
+    for c in (0..n).rev() {
+        let mut s = b[c];
+        for j in c + 1..n {
+            s -= a.at(c, j) * b[j];
+        }
+        b[c] = s / a.at(c, c);
+    }
+    b.iter().all(|v| v.is_finite())
+}
+
+/// Options of the equilibrium solver.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonOptions {
+    /// Converged when every scaled residual `|Q_a| / L_a` is below `tolerance` times the load
+    /// scale `|T| / rp` (or below the round-off floor of the force evaluation, ~1e2 eps
+    /// k_ref rp).
+    pub tolerance: f64,
+    /// Most iterations per equilibrium.
+    pub max_iterations: usize,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-12,
+            max_iterations: 60,
+        }
+    }
+}
+
+/// How one equilibrium was reached.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonReport {
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// Largest scaled residual relative to the force scale.
+    pub residual: f64,
+}
+
+/// The scaled residual norms (max and 2-norm) relative to `force_scale`.
+fn norms(r: &[f64], scale: &[f64], force_scale: f64) -> (f64, f64) {
+    let mut m: f64 = 0.0;
+    let mut s = 0.0;
+    for (v, l) in r.iter().zip(scale) {
+        let x = v / l / force_scale;
+        m = m.max(x.abs());
+        s += x * x;
+    }
+    (m, s.sqrt())
+}
+
+/// Find the equilibrium at crank angle `psi` [rad] and output torque `torque` [N m] from the
+/// guess `q` (overwritten with the solution). `k_ref` [N/m]: reference stiffness of the
+/// regularisation.
+pub fn equilibrium(
+    st: &mut Statics,
+    psi: f64,
+    torque: f64,
+    q: &mut [f64],
+    k_ref: f64,
+    opts: &NewtonOptions,
+    work: &mut Work,
+) -> Result<NewtonReport> {
+    let n = st.dim();
+    // Residuals in N (moments over the unknown's length). Converged at `tolerance` of the load
+    // scale |T| / rp, or below the round-off floor of the force evaluation (positions carry
+    // ~eps |x| of round-off, times the stiffness).
+    let rp = st.scale[0];
+    let load = torque.abs() / rp;
+    let floor = 4.0 * f64::EPSILON * k_ref * rp;
+    let done = (opts.tolerance * load).max(floor);
+    let stalled_ok = (1e-9 * load).max(10.0 * floor);
+    let report_scale = load.max(1.0);
+    let max_pen = st.model.max_penetration;
+    let force_scale = 1.0;
+    let scale = st.scale.clone();
+    let mut r = vec![0.0; n];
+    let mut k = Dense::zeros(n);
+    let mut rt = vec![0.0; n];
+    let mut kt = Dense::zeros(n);
+    let mut a = Dense::zeros(n);
+    let mut dq = vec![0.0; n];
+    let mut qt = vec![0.0; n];
+    st.eval(psi, q, torque, &mut r, &mut k, work, None)?;
+    let (mut rmax, mut r2) = norms(&r, &scale, force_scale);
+    let mut mu = 0.0;
+    let mut it = 0;
+    while rmax > done {
+        if it >= opts.max_iterations {
+            return Err(not_converged(psi, torque, rmax / report_scale, it));
+        }
+        it += 1;
+        let mut accepted = false;
+        for _attempt in 0..12 {
+            a.a.copy_from_slice(&k.a);
+            for (i, l) in scale.iter().enumerate() {
+                a.a[i * n + i] += mu * k_ref * l * l;
+            }
+            dq.copy_from_slice(&r);
+            if !solve_dense(&mut a, &mut dq) {
+                mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
+                continue;
+            }
+            // Line search along dq. The fast path is the full step when it reduces the
+            // residual. Otherwise a one-dimensional search for the minimum of the potential
+            // along dq, on its slope `s(a) = Q(q + a dq) . dq` (positive while the potential
+            // still falls): expand the step while the slope stays positive (inside a clearance
+            // nothing resists and the slope is the load's), then bisect to a point where the
+            // slope has fallen to half of its initial value or below (a strong-Wolfe condition,
+            // Nocedal and Wright section 3.1). No energy is needed.
+            let s0: f64 = r.iter().zip(&dq).map(|(a, b)| a * b).sum();
+            if s0.is_nan() || s0 <= 0.0 {
+                mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
+                continue;
+            }
+            let mut trial = |step: f64, qt: &mut [f64], rt: &mut [f64], kt: &mut Dense| {
+                for i in 0..n {
+                    qt[i] = q[i] + step * dq[i];
+                }
+                // A trial that moves any point by more than the penetration bound, or that
+                // penetrates beyond it, is rejected: a larger step could carry a disc through
+                // a pin onto the next lobe (the nearest-point gap would not notice).
+                let moved = dq
+                    .iter()
+                    .zip(scale.iter())
+                    .fold(0.0f64, |m, (d, l)| m.max((step * d * l).abs()));
+                if moved > max_pen {
+                    return None;
+                }
+                match st.eval(psi, qt, torque, rt, kt, work, None) {
+                    Ok(()) if st.max_penetration > max_pen => None,
+                    Ok(()) => {
+                        let (m2, n2) = norms(rt, &scale, force_scale);
+                        let slope: f64 = rt.iter().zip(dq.iter()).map(|(a, b)| a * b).sum();
+                        Some((m2, n2, slope))
+                    }
+                    Err(_) => None,
+                }
+            };
+            let mut chosen: Option<(f64, f64, f64)> = None;
+            let first = trial(1.0, &mut qt, &mut rt, &mut kt);
+            if let Some((m2, n2, _)) = first
+                && (n2 < (1.0 - 1e-4) * r2 || m2 <= done)
+            {
+                chosen = Some((1.0, m2, n2));
+            } else if rmax <= stalled_ok {
+                // A full Newton step that cannot reduce a residual this small: round-off floor.
+                work.k_last.clone_from(&k);
+                return Ok(NewtonReport {
+                    iterations: it,
+                    residual: rmax / report_scale,
+                });
+            } else {
+                let (mut lo, mut hi) = (0.0, 1.0);
+                let mut lo_norms = (rmax, r2);
+                if let Some((m2, n2, s1)) = first
+                    && s1 > 0.0
+                {
+                    lo = 1.0;
+                    lo_norms = (m2, n2);
+                    hi = f64::INFINITY;
+                    let mut step = 1.0;
+                    for _ in 0..60 {
+                        step *= 2.0;
+                        match trial(step, &mut qt, &mut rt, &mut kt) {
+                            Some((m2, n2, s)) if s > 0.0 => {
+                                lo = step;
+                                lo_norms = (m2, n2);
+                            }
+                            Some((m2, n2, s)) if s.abs() <= 0.5 * s0 => {
+                                chosen = Some((step, m2, n2));
+                                break;
+                            }
+                            _ => {
+                                hi = step;
+                                break;
+                            }
+                        }
+                    }
+                }
+                if chosen.is_none() && hi.is_finite() {
+                    for _ in 0..40 {
+                        let mid = 0.5 * (lo + hi);
+                        match trial(mid, &mut qt, &mut rt, &mut kt) {
+                            Some((m2, n2, s)) if s.abs() <= 0.5 * s0 => {
+                                chosen = Some((mid, m2, n2));
+                                break;
+                            }
+                            Some((m2, n2, s)) if s > 0.0 => {
+                                lo = mid;
+                                lo_norms = (m2, n2);
+                            }
+                            _ => hi = mid,
+                        }
+                    }
+                }
+                if chosen.is_none() && lo > 0.0 {
+                    chosen = Some((lo, lo_norms.0, lo_norms.1));
+                }
+            }
+            if let Some((step, m2, n2)) = chosen {
+                // The last trial is usually the chosen step: keep its evaluation.
+                let same = (0..n).all(|i| qt[i] == q[i] + step * dq[i]);
+                for i in 0..n {
+                    q[i] += step * dq[i];
+                }
+                if same {
+                    std::mem::swap(&mut r, &mut rt);
+                    std::mem::swap(&mut k, &mut kt);
+                } else {
+                    st.eval(psi, q, torque, &mut r, &mut k, work, None)?;
+                }
+                rmax = m2;
+                r2 = n2;
+                accepted = true;
+            }
+            if accepted {
+                mu = if mu <= 1e-6 { 0.0 } else { mu * 0.1 };
+                break;
+            }
+            // A full Newton step that cannot reduce a residual this small: round-off floor.
+            if mu == 0.0 && rmax <= stalled_ok {
+                work.k_last.clone_from(&k);
+                return Ok(NewtonReport {
+                    iterations: it,
+                    residual: rmax / report_scale,
+                });
+            }
+            mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
+        }
+        if !accepted {
+            if rmax <= stalled_ok {
+                break;
+            }
+            return Err(not_converged(psi, torque, rmax / report_scale, it));
+        }
+    }
+    work.k_last.clone_from(&k);
+    Ok(NewtonReport {
+        iterations: it,
+        residual: rmax / report_scale,
+    })
+}
+
+fn not_converged(psi: f64, torque: f64, residual: f64, it: usize) -> RvdynError {
+    RvdynError::Convergence(format!(
+        "the static equilibrium (LTCA) did not converge at crank angle {psi:.6} rad, output \
+         torque {torque:.6e} N m: scaled residual {residual:.3e} of the load after {it} \
+         iterations. Either the torque exceeds what the contacts can carry, or a clearance \
+         leaves a body unsupported (no equilibrium): reduce the torque or the clearances"
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dense_solve_matches_a_known_system_and_flags_singular() {
+        let mut a = Dense {
+            n: 3,
+            a: vec![2.0, 1.0, 0.0, 1.0, 3.0, 1.0, 0.0, 1.0, 4.0],
+        };
+        let x = [1.0, -2.0, 0.5];
+        let mut b = vec![2.0 - 2.0, 1.0 - 6.0 + 0.5, -2.0 + 2.0];
+        assert!(solve_dense(&mut a, &mut b));
+        for i in 0..3 {
+            assert!((b[i] - x[i]).abs() < 1e-14);
+        }
+        let mut s = Dense {
+            n: 2,
+            a: vec![1.0, 2.0, 2.0, 4.0],
+        };
+        assert!(!solve_dense(&mut s, &mut [1.0, 1.0]));
+    }
+}

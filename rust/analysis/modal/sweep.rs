@@ -1,0 +1,134 @@
+//! Modes of a reducer scene at an operating point, over a mesh period, and over the input
+//! speed (Campbell diagram).
+
+use crate::analysis::modal::{Equilibrium, Linearizer, ModalAnalysis, modal_analysis};
+use crate::analysis::orders::{Crossing, ExcitationOrder, campbell_crossings, scene_orders};
+use crate::dynamics::scene::Scene;
+use crate::error::{Result, RvdynError};
+
+/// The modes at one operating point with the equilibrium they were linearised about.
+#[derive(Debug, Clone)]
+pub struct ModalPoint {
+    /// The equilibrium linearised about.
+    pub equilibrium: Equilibrium,
+    /// Its modes.
+    pub analysis: ModalAnalysis,
+    /// The linearised system's mass matrix, row-major n x n [kg, kg m^2].
+    pub mass: Vec<f64>,
+    /// The summed tangent stiffness, row-major n x n [N/m, N m/rad].
+    pub stiffness: Vec<f64>,
+    /// The damping matrix, row-major n x n [N s/m, N m s/rad].
+    pub damping: Vec<f64>,
+}
+
+/// Modes of `scene` about its equilibrium at `crank_angle` [rad] under the output torque
+/// `torque` [N m].
+pub fn modes_at(lin: &mut Linearizer, torque: f64, crank_angle: f64) -> Result<ModalPoint> {
+    let (sys, eq) = lin.linearise(torque, crank_angle)?;
+    let analysis = modal_analysis(&sys)?;
+    let n = sys.dof_names.len();
+    let mut k = nalgebra::DMatrix::<f64>::zeros(n, n);
+    for p in &sys.stiffness {
+        k += &p.matrix;
+    }
+    let row_major = |m: &nalgebra::DMatrix<f64>| -> Vec<f64> {
+        (0..n)
+            .flat_map(|i| (0..n).map(move |j| (i, j)))
+            .map(|(i, j)| m[(i, j)])
+            .collect()
+    };
+    Ok(ModalPoint {
+        equilibrium: eq,
+        mass: row_major(&sys.mass),
+        stiffness: row_major(&k),
+        damping: row_major(&sys.damping),
+        analysis,
+    })
+}
+
+/// A Campbell diagram: natural frequencies over input speed and their crossings with the
+/// excitation orders.
+#[derive(Debug, Clone)]
+pub struct Campbell {
+    /// Input speeds [rad/s].
+    pub speeds: Vec<f64>,
+    /// Output torque at each speed [N m].
+    pub torques: Vec<f64>,
+    /// Undamped natural frequency [Hz], `[speed][mode]`.
+    pub frequencies: Vec<Vec<f64>>,
+    /// Damping ratio of the matched damped eigenvalue (the modal estimate when unmatched),
+    /// `[speed][mode]`.
+    pub damping_ratios: Vec<Vec<f64>>,
+    /// Indices of the modes kept (those in the frequency range at the first speed).
+    pub modes: Vec<usize>,
+    /// The excitation orders of the scene.
+    pub orders: Vec<ExcitationOrder>,
+    /// Crossings (mode indices refer to `modes`' positions).
+    pub crossings: Vec<Crossing>,
+}
+
+/// The Campbell diagram of `scene` at the crank angle `crank_angle` [rad]: at each input speed
+/// `speeds[s]` [rad/s] (increasing) the modes about the equilibrium under `torques[s]` [N m];
+/// the modes in `frequency_range` [Hz] (at the first speed; all if `None`) are kept, and the
+/// crossings of each excitation order (pin-pass and sun-mesh harmonics up to `harmonics`) with
+/// them returned. The speed enters only through the torque (the models have no gyroscopic
+/// or speed-dependent terms: constant masses in planar absolute or reduced coordinates).
+pub fn campbell(
+    scene: &Scene,
+    speeds: &[f64],
+    torques: &[f64],
+    crank_angle: f64,
+    harmonics: u32,
+    frequency_range: Option<(f64, f64)>,
+) -> Result<Campbell> {
+    if torques.len() != speeds.len() {
+        return Err(RvdynError::Parameter(format!(
+            "{} torques for {} speeds",
+            torques.len(),
+            speeds.len()
+        )));
+    }
+    let orders = scene_orders(scene, harmonics)?;
+    // Check the speeds before the work.
+    campbell_crossings(speeds, &vec![Vec::new(); speeds.len()], &orders)?;
+    let mut lin = Linearizer::new(scene)?;
+    let mut frequencies = Vec::with_capacity(speeds.len());
+    let mut damping_ratios = Vec::with_capacity(speeds.len());
+    let mut modes: Option<Vec<usize>> = None;
+    for &t in torques {
+        let (sys, _) = lin.linearise(t, crank_angle)?;
+        let a = modal_analysis(&sys)?;
+        let keep = match &modes {
+            Some(m) => m.clone(),
+            None => {
+                let m = match frequency_range {
+                    Some((lo, hi)) => a.modes_in_range(lo, hi)?,
+                    None => (0..a.modes.len()).collect(),
+                };
+                modes = Some(m.clone());
+                m
+            }
+        };
+        frequencies.push(keep.iter().map(|&i| a.modes[i].frequency).collect());
+        damping_ratios.push(
+            keep.iter()
+                .map(|&i| {
+                    let m = &a.modes[i];
+                    m.damped
+                        .as_ref()
+                        .map_or(m.modal_damping_ratio, |d| d.damping_ratio)
+                })
+                .collect(),
+        );
+    }
+    let crossings = campbell_crossings(speeds, &frequencies, &orders)?;
+    Ok(Campbell {
+        speeds: speeds.to_vec(),
+        torques: torques.to_vec(),
+        frequencies,
+        damping_ratios,
+        modes: modes.unwrap_or_default(),
+        orders,
+        crossings,
+    })
+}

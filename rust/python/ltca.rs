@@ -1,0 +1,242 @@
+//! Bindings of the quasi-static analysis (`rvdyn.analysis`): a solver object that keeps its
+//! warm start and its points across calls. Every number is computed by
+//! [`crate::analysis::ltca`]; this file converts and packs.
+
+use crate::analysis::ltca::export::{loads_csv, loads_json, worst_loads};
+use crate::analysis::ltca::{Ltca, LtcaPoint, NewtonOptions};
+use crate::error::RvdynError;
+use crate::python::scene::CompiledScene;
+use numpy::{IntoPyArray, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::Mutex;
+
+/// The loaded tooth contact analysis of one scene (use `rvdyn.analysis`, which wraps it).
+#[pyclass(name = "LtcaSolver", module = "rvdyn._core")]
+pub(crate) struct LtcaSolver {
+    /// Behind a mutex: the core keeps per-contact warm starts in cells (not `Sync`).
+    ltca: Mutex<Ltca>,
+    face_width: f64,
+    /// Every point solved by `sweep` since construction (for the FEA loads).
+    points: Vec<LtcaPoint>,
+}
+
+fn f64_array<'py>(py: Python<'py>, v: Vec<f64>, shape: Vec<usize>) -> PyResult<Bound<'py, PyAny>> {
+    Ok(v.into_pyarray(py).reshape(shape)?.into_any())
+}
+
+#[pymethods]
+impl LtcaSolver {
+    /// A solver for `scene` converging to `tolerance` of the load scale.
+    #[new]
+    fn py_new(scene: &CompiledScene, tolerance: f64) -> PyResult<Self> {
+        let opts = NewtonOptions {
+            tolerance,
+            ..NewtonOptions::default()
+        };
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(RvdynError::Parameter(format!(
+                "tolerance must be a finite number > 0, got {tolerance}"
+            ))
+            .into());
+        }
+        Ok(Self {
+            ltca: Mutex::new(Ltca::with_options(&scene.scene, opts)?),
+            face_width: scene.scene.cycloid.face_width,
+            points: Vec::new(),
+        })
+    }
+
+    /// Crank-angle period of the contact pattern [rad].
+    #[getter]
+    fn mesh_period(&self) -> PyResult<f64> {
+        Ok(self.lock()?.mesh_period())
+    }
+
+    /// Transmission ratio input/output.
+    #[getter]
+    fn ratio(&self) -> PyResult<f64> {
+        Ok(self.lock()?.ratio())
+    }
+
+    /// Disc face width [m].
+    #[getter]
+    fn face_width(&self) -> f64 {
+        self.face_width
+    }
+
+    /// Equilibria at `crank_angles` [rad] under `torque` [N m] (warm-started from the last
+    /// call); a dict of numpy arrays with the crank angle first.
+    fn sweep<'py>(
+        &mut self,
+        py: Python<'py>,
+        torque: f64,
+        crank_angles: Vec<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
+        let pts = py.detach(|| ltca.sweep(torque, &crank_angles))?;
+        let d = pack(py, &pts)?;
+        self.points.extend(pts);
+        Ok(d)
+    }
+
+    /// The worst load case of each disc over every point solved so far, as (CSV, JSON).
+    fn fea_loads(&self) -> PyResult<(String, String)> {
+        let loads = worst_loads(&self.points)?;
+        Ok((loads_csv(&loads), loads_json(&loads, self.face_width)?))
+    }
+
+    /// TE over one mesh period at `points` crank angles from `start` [rad], at +-`torque` and
+    /// +-`light` [N m].
+    fn transmission_error<'py>(
+        &mut self,
+        py: Python<'py>,
+        torque: f64,
+        light: f64,
+        points: usize,
+        start: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
+        let te = py.detach(|| ltca.transmission_error(torque, light, points, start))?;
+        let d = PyDict::new(py);
+        let n = te.crank_angle.len();
+        d.set_item("crank_angle", f64_array(py, te.crank_angle, vec![n])?)?;
+        d.set_item("period", te.period)?;
+        d.set_item("forward", f64_array(py, te.forward, vec![n])?)?;
+        d.set_item("reverse", f64_array(py, te.reverse, vec![n])?)?;
+        d.set_item(
+            "unloaded_forward",
+            f64_array(py, te.unloaded_forward, vec![n])?,
+        )?;
+        d.set_item(
+            "unloaded_reverse",
+            f64_array(py, te.unloaded_reverse, vec![n])?,
+        )?;
+        Ok(d)
+    }
+
+    /// The torque-twist loop at `crank_angle` [rad] over +-`rated` [N m] with `points` points.
+    fn twist_loop<'py>(
+        &mut self,
+        py: Python<'py>,
+        rated: f64,
+        crank_angle: f64,
+        points: usize,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
+        let lp = py.detach(|| ltca.twist_loop(rated, crank_angle, points))?;
+        let d = PyDict::new(py);
+        let n = lp.torque.len();
+        d.set_item("torque", f64_array(py, lp.torque, vec![n])?)?;
+        d.set_item("twist", f64_array(py, lp.twist, vec![n])?)?;
+        d.set_item(
+            "tangent_stiffness",
+            f64_array(py, lp.tangent_stiffness, vec![n])?,
+        )?;
+        d.set_item("rigidity", lp.rigidity)?;
+        d.set_item("lost_motion", lp.lost_motion)?;
+        d.set_item("backlash", lp.backlash)?;
+        Ok(d)
+    }
+}
+
+impl LtcaSolver {
+    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, Ltca>> {
+        self.ltca.lock().map_err(|_| poisoned())
+    }
+}
+
+fn poisoned() -> PyErr {
+    RvdynError::Convergence("the LTCA solver failed in an earlier call; build a new one".into())
+        .into()
+}
+
+/// LTCA points as arrays (first axis: crank angle).
+fn pack<'py>(py: Python<'py>, pts: &[LtcaPoint]) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let n = pts.len();
+    let nd = pts.first().map_or(0, |p| p.pins.len());
+    let zp = pts
+        .first()
+        .map_or(0, |p| p.pins.first().map_or(0, |r| r.len()));
+    let ncr = pts.first().map_or(0, |p| p.mesh_force.len());
+    let scalar = |f: &dyn Fn(&LtcaPoint) -> f64| pts.iter().map(f).collect::<Vec<f64>>();
+    for (name, v) in [
+        ("crank_angle", scalar(&|p| p.crank_angle)),
+        ("output_angle", scalar(&|p| p.output_angle)),
+        ("input_angle", scalar(&|p| p.input_angle)),
+        ("transmission_error", scalar(&|p| p.transmission_error)),
+        ("input_torque", scalar(&|p| p.input_torque)),
+        ("torque_balance", scalar(&|p| p.torque_balance)),
+        ("residual", scalar(&|p| p.residual)),
+        ("torsional_stiffness", scalar(&|p| p.torsional_stiffness)),
+    ] {
+        d.set_item(name, f64_array(py, v, vec![n])?)?;
+    }
+    let iters: Vec<i64> = pts.iter().map(|p| p.iterations as i64).collect();
+    d.set_item("iterations", iters.into_pyarray(py))?;
+    let per_pin = |f: &dyn Fn(&crate::analysis::ltca::PinLoad) -> f64| {
+        pts.iter()
+            .flat_map(|p| p.pins.iter().flatten().map(f))
+            .collect::<Vec<f64>>()
+    };
+    for (name, v) in [
+        ("pin_force", per_pin(&|l| l.force)),
+        ("pin_gap", per_pin(&|l| l.gap)),
+        ("half_width", per_pin(&|l| l.half_width)),
+        ("peak_pressure", per_pin(&|l| l.peak_pressure)),
+    ] {
+        d.set_item(name, f64_array(py, v, vec![n, nd, zp])?)?;
+    }
+    let pair = |f: &dyn Fn(&crate::analysis::ltca::PinLoad) -> [f64; 2]| {
+        pts.iter()
+            .flat_map(|p| p.pins.iter().flatten().flat_map(f))
+            .collect::<Vec<f64>>()
+    };
+    d.set_item(
+        "contact_point",
+        f64_array(py, pair(&|l| l.point), vec![n, nd, zp, 2])?,
+    )?;
+    d.set_item(
+        "contact_normal",
+        f64_array(py, pair(&|l| l.normal), vec![n, nd, zp, 2])?,
+    )?;
+    let loaded: Vec<i64> = pts
+        .iter()
+        .flat_map(|p| p.loaded_pins.iter().map(|&c| c as i64))
+        .collect();
+    d.set_item("loaded_pins", loaded.into_pyarray(py).reshape(vec![n, nd])?)?;
+    let rot: Vec<f64> = pts.iter().flat_map(|p| p.disc_rotation.clone()).collect();
+    d.set_item("disc_rotation", f64_array(py, rot, vec![n, nd])?)?;
+    let disp: Vec<f64> = pts
+        .iter()
+        .flat_map(|p| p.disc_displacement.iter().flatten().copied())
+        .collect();
+    d.set_item("disc_displacement", f64_array(py, disp, vec![n, nd, 2])?)?;
+    let mesh: Vec<f64> = pts.iter().flat_map(|p| p.mesh_force.clone()).collect();
+    d.set_item("mesh_force", f64_array(py, mesh, vec![n, ncr])?)?;
+    let nb = pts.first().map_or(0, |p| p.crank_bearing_force.len());
+    let cb: Vec<f64> = pts
+        .iter()
+        .flat_map(|p| p.crank_bearing_force.iter().flatten().copied())
+        .collect();
+    d.set_item("crank_bearing_force", f64_array(py, cb, vec![n, nb, 2])?)?;
+    let ne = pts.first().map_or(0, |p| p.eccentric_bearing_force.len());
+    let eb: Vec<f64> = pts
+        .iter()
+        .flat_map(|p| p.eccentric_bearing_force.iter().flatten().copied())
+        .collect();
+    let shape = if ne > 0 && nd > 0 {
+        vec![n, ne / nd, nd, 2]
+    } else {
+        vec![n, 0, nd, 2]
+    };
+    d.set_item("eccentric_bearing_force", f64_array(py, eb, shape)?)?;
+    Ok(d)
+}
+
+/// Add the solver class to the module.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<LtcaSolver>()?;
+    Ok(())
+}

@@ -1,0 +1,145 @@
+"""User contract of the quasi-static analysis (rvdyn.analysis): LTCA, TE, torque-twist loop,
+loads for FEA, the analyze command; checked against a slow dynamic run of the same scene."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rvdyn
+from rvdyn import Scene, simulate
+from rvdyn.analysis import ARCMIN, ARCSEC, ltca, torque_twist, transmission_error
+
+RATED = 43_921.3
+INPUT_SPEED = math.radians(8328.0)
+LINEAR = {"kind": "impact", "stiffness": 1.0e9, "exponent": 1.0, "max_damping": 2.0e5, "damping_depth": 1e-6}
+
+
+@pytest.fixture(scope="module")
+def slow_run() -> tuple[Scene, rvdyn.Result]:
+    # Quasi-static: input at 1/50 of the paper's speed from a steady start, well damped linear
+    # pin law (the setup of the classical load-sharing check in test_simulation.py).
+    scene = Scene.paper("rated", **{"contact.pin": LINEAR, "drive.speed": INPUT_SPEED / 50, "initial": "steady"})
+    return scene, simulate(scene, 0.4, "dopri5", atol=1e-10, record_interval=1e-3)
+
+
+def test_ltca_agrees_with_a_slow_dynamic_run(slow_run: tuple[Scene, rvdyn.Result]) -> None:
+    # Same scene and law, the input held where the run's input is: crank angle
+    # psi = -zc th_s / i. Contract: peak pin force within 1 %, loaded-pin count exact, at the
+    # last 5 samples of the steady window.
+    scene, run = slow_run
+    zc, ratio = 23.0, scene.ratio
+    idx = np.arange(run.t.size - 5, run.t.size)
+    psi = -zc * run.sun_angle[idx] / ratio
+    res = ltca(scene, RATED, psi)
+    for n, i in enumerate(idx):
+        f_dyn = run.pin_force[i]
+        f_st = res.pin_force[n]
+        peak = f_st.max()
+        assert abs(f_dyn.max() / peak - 1.0) < 0.01, (f_dyn.max(), peak)
+        # Exact count: pins that carry more than a newton (the dynamic run's contact noise at
+        # the edge of the loaded zone is far below that).
+        assert np.array_equal((f_dyn > 1.0).sum(axis=1), (f_st > 1.0).sum(axis=1))
+
+
+def test_te_agrees_with_the_slow_dynamic_run(slow_run: tuple[Scene, rvdyn.Result]) -> None:
+    # TE = output - input / i over the steady window (0.2 s to 0.4 s, more than a mesh period
+    # of 0.0134 s of crank angle at this speed): within 1 % of the LTCA's peak-to-peak, after
+    # removing the mean (the run's mean carries the damper forces of the moving contacts).
+    scene, run = slow_run
+    i0 = np.searchsorted(run.t, 0.2)
+    te_dyn = run.carrier_angle[i0:] - run.sun_angle[i0:] / scene.ratio
+    psi = -23.0 * run.sun_angle[i0:] / scene.ratio
+    res = ltca(scene, RATED, psi)
+    te_st = res.transmission_error
+    pp = np.ptp(te_st)
+    assert pp > 0
+    diff = (te_dyn - te_dyn.mean()) - (te_st - te_st.mean())
+    assert np.max(np.abs(diff)) < 0.01 * pp, (np.max(np.abs(diff)), pp)
+
+
+def test_result_arrays_balances_and_plots(tmp_path: Path) -> None:
+    scene = Scene.paper("rated").with_compliant_joints()
+    res = ltca(scene, RATED, np.linspace(0.0, 0.2, 7))
+    n = 7
+    assert res.pin_force.shape == (n, 2, 24)
+    assert res.contact_point.shape == (n, 2, 24, 2)
+    assert res.loaded_pins.shape == (n, 2)
+    assert res.eccentric_bearing_force.shape == (n, 3, 2, 2)
+    assert res.crank_bearing_force.shape == (n, 3, 2)
+    assert np.all(res.torque_balance < 1e-9)
+    assert np.all(res.residual < 1e-9)
+    assert np.all(res.transmission_error < 0)
+    # Unloaded pins carry nothing and have no Hertz strip.
+    assert np.all((res.pin_force > 0) == (res.half_width > 0))
+    s = res.summary()
+    assert 10 <= s["loaded_pins_min"] <= s["loaded_pins_max"] <= 13
+    for fig in (res.plot_load_distribution(), res.plot_load_distribution(polar=False),
+                res.plot_contact_pressure()):
+        assert fig.axes
+    csv_path, json_path = res.save_fea_loads(tmp_path)
+    doc = json.loads(json_path.read_text())
+    assert doc["format"] == "rvdyn-ltca-loads/1"
+    lines = csv_path.read_text().splitlines()
+    assert lines[0].startswith("disc,pin,crank_angle_rad")
+    assert len(lines) == len(doc["loads"]) + 1
+    worst = max(ld["force"] for ld in doc["loads"])
+    assert worst == pytest.approx(res.peak_pin_force, rel=1e-15)
+
+
+def test_zero_load_zero_te_and_reversed_torque_mirrors() -> None:
+    scene = Scene.paper("rated")
+    zero = ltca(scene, 0.0, [0.0, 0.3])
+    assert np.max(np.abs(zero.transmission_error)) < 1e-12
+    te = transmission_error(scene.replace(**{"cycloid.d_rrp": 2e-5, "cycloid.d_rp": -2e-5}), RATED, 24)
+    # Mirror symmetry: reverse TE at psi = -(forward TE) at -psi; over a whole period the
+    # peak-to-peak values agree.
+    pp = te.peak_to_peak()
+    assert pp["forward"] == pytest.approx(pp["reverse"], rel=1e-6)
+    assert np.all(te.lost_motion() > 0)
+    assert te.plot().axes
+
+
+def test_torque_twist_loop_units_and_conventions() -> None:
+    scene = Scene.paper("rated").replace(**{"cycloid.d_rrp": 2e-5, "cycloid.d_rp": -2e-5})
+    loop = torque_twist(scene, RATED, 0.0, 41)
+    s = loop.summary()
+    assert loop.torque.shape == loop.twist.shape == (41,)
+    assert s["rigidity_Nm_per_arcmin"] == pytest.approx(loop.rigidity * ARCMIN)
+    assert loop.backlash > 0 and loop.lost_motion > loop.backlash
+    # Twist grows with torque on the loading branch.
+    up = loop.torque[:11]
+    assert np.all(np.diff(loop.twist[:11]) > 0) and up[-1] == pytest.approx(RATED)
+    assert loop.plot().axes
+    assert ARCSEC * 60 == pytest.approx(ARCMIN)
+
+
+def test_bad_input_is_a_clear_error() -> None:
+    scene = Scene.paper("rated")
+    with pytest.raises(rvdyn.ParameterError):
+        ltca(scene, float("nan"), [0.0])
+    with pytest.raises(rvdyn.ParameterError):
+        ltca(scene, RATED, [float("inf")])
+    with pytest.raises(rvdyn.ConvergenceError, match="crank angle"):
+        ltca(scene, 1e9, [0.1])
+    with pytest.raises(rvdyn.ParameterError):
+        ltca("paper", RATED, [0.0])  # type: ignore[arg-type]
+
+
+def test_analyze_command_writes_figures_loads_and_summary(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, "-m", "rvdyn", "analyze", "--out", str(out), "--angles", "12",
+                        "--loop-points", "21"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    for name in ("load_distribution.png", "contact_pressure.png", "transmission_error.png",
+                 "torque_twist.png", "fea_loads.csv", "fea_loads.json", "summary.md", "summary.json"):
+        assert (out / name).exists(), name
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["rigidity_Nm_per_arcmin"] > 0
+    assert "LTCA: 12/12" in r.stderr
