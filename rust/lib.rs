@@ -12,6 +12,8 @@
 //!
 //! Units are SI everywhere: m, kg, s, N, rad, Pa.
 
+#![warn(missing_docs)]
+
 pub mod analysis;
 pub mod contact;
 pub mod dynamics;

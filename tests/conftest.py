@@ -9,7 +9,7 @@ import pytest
 
 import rvdyn
 
-#: The default disc (design.md section 7).
+#: The default disc (docs/model.md#default-scene).
 ZP, E, RP, RRP, FACE = 24, 4.5e-3, 0.150, 0.010, 0.040
 ZC = ZP - 1
 K1 = E * ZP / RP

@@ -101,7 +101,7 @@ def test_stiffness_broadcasting_and_shapes():
 
 
 def test_hertz_hand_values():
-    # notes/physics.md section 3: F = 35 kN over 40 mm, R_pin 10 mm, R_disc 94 mm:
+    # docs/model.md#contact-laws: F = 35 kN over 40 mm, R_pin 10 mm, R_disc 94 mm:
     # R = 9.0385 mm, E* = 1.19231e11 Pa, a = sqrt(4 P R/(pi E*)) = 0.29061 mm,
     # p0 = 2P/(pi a) = 1.9168 GPa, approach (Johnson) 2.5905e-5 m. Five digits: rel 1e-4.
     c = rvdyn.hertz_line_contact(35e3, 0.040, 0.010, 0.094)

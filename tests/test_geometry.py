@@ -24,7 +24,7 @@ def test_properties_of_the_paper_disc(paper_disc):
     # K1 = 4.5 * 24 / 150 = 0.72 and rc' = 4.5 * 23 = 103.5 mm; exact up to round-off.
     assert g.k1 == pytest.approx(0.72, abs=1e-15)
     assert g.pitch_radius == pytest.approx(0.1035, abs=1e-15)
-    # notes/physics.md 1.4: rho_min(convex) = 20.75 mm (given to 0.01 mm).
+    # docs/validation.md: rho_min(convex) = 20.75 mm (given to 0.01 mm).
     assert g.min_convex_radius == pytest.approx(20.75e-3, abs=0.01e-3)
     assert "pins=24" in repr(g) and "eccentricity=0.0045" in repr(g)
 
@@ -52,7 +52,7 @@ def test_root_radius_with_and_without_modifications():
 
 
 def test_profile_matches_the_closed_form(paper_disc):
-    # notes/physics.md 1.2: x = (rp - rrp/S) cos phi - (e - K1 rrp/S) cos(zp phi), same for y.
+    # docs/validation.md: x = (rp - rrp/S) cos phi - (e - K1 rrp/S) cos(zp phi), same for y.
     phi = np.linspace(-3.0, 9.0, 5001)
     s = np.sqrt(1.0 + K1**2 - 2.0 * K1 * np.cos(ZC * phi))
     x = (RP - RRP / s) * np.cos(phi) - (E - K1 * RRP / s) * np.cos(ZP * phi)
@@ -79,7 +79,7 @@ def test_normals_are_unit_outward_and_orthogonal(paper_disc):
 
 
 def test_curvature_radius_root_value_and_finite_differences(paper_disc):
-    # notes/physics.md 1.4: -10.72 mm at the root (concave, nearly conformal with the 10 mm pin).
+    # docs/validation.md: -10.72 mm at the root (concave, nearly conformal with the 10 mm pin).
     # The note gives 2 decimals in mm, so +-0.005 mm.
     assert paper_disc.curvature_radius(0.0) == pytest.approx(-10.72e-3, abs=0.005e-3)
     assert isinstance(paper_disc.curvature_radius(0.0), float)
@@ -213,7 +213,7 @@ def test_gap_of_pins_beyond_the_root_centre_of_curvature(d_rp):
 
 
 def test_modifications_open_the_first_order_clearance():
-    # notes/physics.md 1.3: g0(phi) = d_rrp - d_rp (1 - K1 cos phi)/S at the kinematic pose,
+    # docs/validation.md: g0(phi) = d_rrp - d_rp (1 - K1 cos phi)/S at the kinematic pose,
     # phi the pin angle from the eccentricity direction. The exact gap differs at second order:
     # ~3e-5 mm for 0.02 mm modifications, so 1e-7 m is a tolerance with a 3x margin, and the
     # difference must be visible (> 1e-10 m), or the test would not see the second order.
@@ -262,7 +262,7 @@ def test_mass_properties_against_a_polygon(paper_disc):
     mass, inertia = paper_disc.mass_properties()
     assert mass == pytest.approx(area * FACE * 7850.0, rel=1e-8)
     assert inertia == pytest.approx(polar * FACE * 7850.0, rel=1e-8)
-    # design.md section 7 estimate "about 14.7 kg and 0.163 kg m^2": within 2 %.
+    # docs/model.md#default-scene estimate "about 14.7 kg and 0.163 kg m^2": within 2 %.
     assert mass == pytest.approx(14.7, rel=0.02)
     assert inertia == pytest.approx(0.163, rel=0.02)
     # The default density is steel, 7850 kg/m^3, as the signature says.

@@ -28,7 +28,7 @@ def rated_run() -> Result:
 
 
 def test_mean_output_speed_is_input_over_57(rated_run: Result) -> None:
-    # A gear train cannot slip (design.md erratum 5): over whole crank revolutions the mean
+    # A gear train cannot slip (docs/model.md#errata-of-the-paper, erratum 5): over whole crank revolutions the mean
     # output speed equals input/57 up to the change of elastic deflection, ~1e-9 here. The
     # contract is 1e-4 relative; the paper's 0.83 % would fail by a factor of 80.
     mean = rated_run.mean_output_speed(0.1)
@@ -61,7 +61,7 @@ def test_result_shapes_and_units(rated_run: Result) -> None:
 
 
 def test_pin_forces_follow_classical_load_sharing() -> None:
-    # notes/physics.md 2.1: with a linear contact law (exponent 1) and an unmodified profile,
+    # docs/validation.md: with a linear contact law (exponent 1) and an unmodified profile,
     # the penetration of pin i is proportional to its lever l_i about the disc centre (the
     # pin and crank levers are proportional: l_ring = zp/zc l_c), so F_i = F_max sin(phi_i)/S_i
     # on the loaded half. A slow, well damped run is quasi-static: tolerance 1 % of F_max.
@@ -199,11 +199,15 @@ def test_sweep_runs_a_grid_and_reports_failures() -> None:
     peaks = [o.pin_force.max() for o in out]
     assert peaks[1] > peaks[0]
     bad = rvdyn.sweep([base, base], 0.05, "rk4", dt=5e-4, channels=["pins"])
-    assert all(isinstance(b, rvdyn.SimulationError) for b in bad)
+    # Issue 7: sweep returns Result objects with ok/error (it returned the exceptions).
+    assert all(not b.ok and isinstance(b.error, rvdyn.SimulationError) for b in bad)
 
 
 def test_ctrl_c_stops_a_run_cleanly() -> None:
-    code = "import rvdyn; rvdyn.simulate(rvdyn.Scene.paper('rated'), 600.0, channels=['motion'], max_samples=1000)"
+    # The child restores the default SIGINT handler: a parent started from a background job
+    # ignores SIGINT and the child would inherit that (the test checks rvdyn, not the shell).
+    code = ("import signal; signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+            "import rvdyn; rvdyn.simulate(rvdyn.Scene.paper('rated'), 600.0, channels=['motion'], max_samples=1000)")
     proc = subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE, text=True)
     time.sleep(3.0)
     proc.send_signal(signal.SIGINT)

@@ -13,8 +13,10 @@ contact_stiffness, stiffness_maximum, hertz_line_contact, impact_force
     Contact laws (vectorised, numpy in and out).
 transmission_ratio, body_speeds, operating_point
     Kinematics and the operating point.
-Scene, simulate, sweep, Result
-    Reducer scenes, dynamic runs (one or many in parallel) and their recorded results.
+Scene, Options, simulate, sweep, Result
+    Reducer scenes, run options, dynamic runs (one or many in parallel) and their recorded
+    results. The theory is in the repository's ``docs/model.md``, the user guide in
+    ``docs/guide.md``.
 rvdyn.plotting
     Matplotlib figures (geometry, contact stiffness).
 """
@@ -45,7 +47,7 @@ from ._core import (
 from ._types import GapResult, LineContact, OperatingPoint
 from .result import Result
 from .scene import Scene
-from .simulation import INTEGRATORS, simulate, sweep
+from .simulation import INTEGRATORS, Options, simulate, sweep
 from .errors import (
     ConvergenceError,
     GeometryError,
@@ -61,6 +63,7 @@ __all__ = [
     "__version__",
     "Scene",
     "Result",
+    "Options",
     "simulate",
     "sweep",
     "INTEGRATORS",

@@ -5,7 +5,7 @@ float, a sequence or a numpy array; functions marked "broadcast" combine their a
 with numpy's broadcasting rules and return a float when every array argument is a scalar.
 """
 
-from typing import Any, Union
+from typing import Any, Sequence, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -13,6 +13,34 @@ from numpy.typing import ArrayLike, NDArray
 from ._types import GapResult, LineContact, OperatingPoint
 
 _FloatOrArray = Union[float, NDArray[np.float64]]
+
+__all__ = [
+    "__version__",
+    "CycloidGeometry",
+    "InvoluteStage",
+    "contact_stiffness",
+    "stiffness_maximum",
+    "hertz_line_contact",
+    "impact_force",
+    "PAPER_IMPACT_STIFFNESS",
+    "PAPER_IMPACT_EXPONENT",
+    "PAPER_IMPACT_MAX_DAMPING",
+    "PAPER_IMPACT_DEPTH",
+    "PAPER_STIFFNESS_R1",
+    "PAPER_STIFFNESS_R2",
+    "transmission_ratio",
+    "body_speeds",
+    "operating_point",
+    "PAPER_PRINTED_OUTPUT_TORQUE",
+    "CompiledScene",
+    "default_compliant_joints",
+    "Options",
+    "options_from_dict",
+    "integrators",
+    "channels",
+    "simulate",
+    "sweep",
+]
 
 __version__: str
 
@@ -32,6 +60,7 @@ PAPER_PRINTED_OUTPUT_TORQUE: float
 """The output torque printed in the paper, 4024.9 N m: inconsistent with its 112 kW (it is
 10.3 kW at the output speed); the lossless value is 43.92 kN m."""
 
+@final
 class CycloidGeometry:
     """A validated cycloid disc and its pin ring (SI units: m, rad).
 
@@ -44,8 +73,8 @@ class CycloidGeometry:
     non-positive sizes.
     """
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         pins: int,
         eccentricity: float,
         pin_circle_radius: float,
@@ -54,7 +83,7 @@ class CycloidGeometry:
         d_rp: float = 0.0,
         d_rrp: float = 0.0,
         d_delta: float = 0.0,
-    ) -> None: ...
+    ) -> CycloidGeometry: ...
     @classmethod
     def paper(cls) -> CycloidGeometry:
         """The paper's default disc: zp 24, e 4.5 mm (given); rp 150 mm, rrp 10 mm, face 40 mm
@@ -129,6 +158,7 @@ class CycloidGeometry:
         default holes, for a density [kg/m^3]."""
     def __reduce__(self) -> tuple[Any, ...]: ...
 
+@final
 class InvoluteStage:
     """The involute first stage (sun and equally spaced planets; SI units).
 
@@ -139,8 +169,8 @@ class InvoluteStage:
     ParameterError (non-finite or non-positive sizes, pressure angle out of range).
     """
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         z_sun: int,
         z_planet: int,
         planets: int,
@@ -148,7 +178,7 @@ class InvoluteStage:
         pressure_angle: float,
         face_width: float,
         backlash: float = 0.0,
-    ) -> None: ...
+    ) -> InvoluteStage: ...
     @classmethod
     def paper(cls) -> InvoluteStage:
         """The paper's stage: 18/42 teeth, 3 planets (given); module 3 mm, 20 deg, face 30 mm
@@ -277,57 +307,128 @@ def body_speeds(
 def operating_point(power: float, input_speed: float, ratio: float) -> OperatingPoint:
     """Lossless operating point for power [W], input speed [rad/s] and ratio [-]."""
 
-# ---- scenes and dynamic runs (rust/python/simulate.rs; wrapped by rvdyn.Scene, rvdyn.simulate,
-# rvdyn.sweep and rvdyn.Result: use those) ----------------------------------------------------
+# ---- scenes and dynamic runs (rust/python/scene.rs, rust/python/simulate.rs; wrapped by
+# rvdyn.Scene, rvdyn.simulate, rvdyn.sweep and rvdyn.Result: use those) -----------------------
 
-def scene_paper(load: str) -> str:
-    """The default scene as JSON; load is "idle", "paper" or "rated"."""
+@final
+class CompiledScene:
+    """A validated scene held by the core (immutable); ``rvdyn.Scene`` wraps it."""
 
-def scene_validate(json: str) -> str:
-    """Validate a scene given as JSON; returns it normalised (defaults filled in) as JSON."""
-
-def scene_to_toml(json: str) -> str:
-    """Scene JSON -> TOML text."""
-
-def scene_from_toml(text: str) -> str:
-    """TOML text -> validated scene JSON."""
-
-def scene_model_info(json: str) -> dict[str, Any]:
-    """Mass properties [kg, kg m^2] and generalised masses the model uses for a scene (SI),
-    crank radius [m], ratio, number of free coordinates (dof) and joint kind."""
+    @staticmethod
+    def from_json(text: str) -> CompiledScene:
+        """Validate a scene given as JSON text (unknown fields are errors)."""
+    @staticmethod
+    def from_toml(text: str) -> CompiledScene:
+        """Validate a scene given as TOML text."""
+    @staticmethod
+    def paper(load: str) -> CompiledScene:
+        """The default scene; load is "idle", "paper" or "rated"."""
+    def to_json(self, indent: bool = True) -> str:
+        """The scene as JSON text."""
+    def to_toml(self) -> str:
+        """The scene as TOML text."""
+    def get(self, path: str) -> str:
+        """The value at a dotted field path, as JSON text."""
+    def replace(self, changes: list[tuple[str, str]]) -> CompiledScene:
+        """A new validated scene with (dotted path, JSON value) changes."""
+    def model_info(self) -> dict[str, Any]:
+        """Mass properties [kg, kg m^2] and generalised masses the model uses (SI), crank radius
+        [m], ratio, number of free coordinates (dof) and joint kind."""
+    def __eq__(self, value: object, /) -> bool: ...
+    def __hash__(self) -> int: ...
 
 def default_compliant_joints() -> str:
     """The default compliant joints (assumed bearing stiffness [N/m] and damping [N s/m]) as JSON."""
 
+@final
+class Options:
+    """Options of a dynamic run (all but the end time), validated when built; None = default.
+
+    integrator: "generalized-alpha" (default), "dopri5" or "rk4"; dt [s] (None = the
+    integrator's default: 1e-4, 1e-6 (initial), 1e-5 s); rtol (adaptive, velocities, default
+    1e-6); atol [m] (displacement tolerance, default 1e-9 m); rho_inf in [0, 1] (default 0.8);
+    record_interval [s] (None = 1e-4 s); max_samples (default 50 000); channels (groups:
+    "motion", "pins", "contact_points", "mesh", "energy"; None = all but contact points);
+    skip_separated (default True).
+    """
+
+    def __new__(
+        cls,
+        integrator: str | None = None,
+        *,
+        dt: float | None = None,
+        rtol: float | None = None,
+        atol: float | None = None,
+        rho_inf: float | None = None,
+        record_interval: float | None = None,
+        max_samples: int | None = None,
+        channels: Sequence[str] | str | None = None,
+        skip_separated: bool | None = None,
+    ) -> Options: ...
+    def replace(
+        self,
+        *,
+        integrator: str | None = None,
+        dt: float | None = None,
+        rtol: float | None = None,
+        atol: float | None = None,
+        rho_inf: float | None = None,
+        record_interval: float | None = None,
+        max_samples: int | None = None,
+        channels: Sequence[str] | str | None = None,
+        skip_separated: bool | None = None,
+    ) -> Options:
+        """A copy with the options given (not None) changed."""
+    @property
+    def integrator(self) -> str:
+        """Integrator name."""
+    @property
+    def dt(self) -> float | None:
+        """Step [s] (initial step of an adaptive method); None = the integrator's default."""
+    @property
+    def rtol(self) -> float:
+        """Relative velocity tolerance of the adaptive method."""
+    @property
+    def atol(self) -> float:
+        """Displacement tolerance [m]."""
+    @property
+    def rho_inf(self) -> float:
+        """Spectral radius at infinite frequency of generalized-alpha."""
+    @property
+    def record_interval(self) -> float | None:
+        """Sample interval [s]; None = 1e-4 s."""
+    @property
+    def max_samples(self) -> int:
+        """Most samples kept."""
+    @property
+    def channels(self) -> list[str]:
+        """Channel groups recorded."""
+    @property
+    def skip_separated(self) -> bool:
+        """Whether pins that provably cannot touch skip the exact gap query."""
+    def to_dict(self) -> dict[str, Any]:
+        """The options as a dict of constructor arguments."""
+    def resolved(self, t_end: float) -> dict[str, Any]:
+        """The options a run to t_end [s] actually uses (step and sample interval resolved)."""
+    def __reduce__(self) -> tuple[Any, tuple[dict[str, Any]]]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+
+def options_from_dict(d: dict[str, Any]) -> Options:
+    """Rebuild options from Options.to_dict() (used by pickle)."""
+
+def integrators() -> list[tuple[str, str, float, bool]]:
+    """The registered integrators: (name, summary, default step [s], adaptive)."""
+
+def channels() -> list[dict[str, Any]]:
+    """The channel registry: name, group, shape (dimension names), unit, dtype, doc per channel."""
+
 def simulate(
-    scene_json: str,
-    t_end: float,
-    integrator: str,
-    dt: float | None = None,
-    rtol: float | None = None,
-    atol: float | None = None,
-    rho_inf: float | None = None,
-    record_interval: float | None = None,
-    max_samples: int | None = None,
-    channels: list[str] | None = None,
-    progress: bool = False,
-    skip_separated: bool = True,
-) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Run one scene for t_end [s]; returns (recorded numpy arrays, run statistics).
-    skip_separated: do not query pins that provably cannot touch (same answer, less work)."""
+    scene: CompiledScene, t_end: float, options: Options, progress: bool = False
+) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
+    """Run one scene for t_end [s]; returns (recorded numpy arrays, run statistics)."""
 
 def sweep(
-    scene_jsons: list[str],
-    t_end: float,
-    integrator: str,
-    dt: float | None = None,
-    rtol: float | None = None,
-    atol: float | None = None,
-    rho_inf: float | None = None,
-    record_interval: float | None = None,
-    max_samples: int | None = None,
-    channels: list[str] | None = None,
-    threads: int | None = None,
-    skip_separated: bool = True,
-) -> list[tuple[dict[str, Any], dict[str, Any]] | BaseException]:
-    """Run many scenes in parallel; per scene (arrays, statistics) or the exception it raised."""
+    scenes: list[CompiledScene], t_end: float, options: Options, threads: int | None = None
+) -> list[tuple[dict[str, NDArray[Any]], dict[str, Any]] | BaseException]:
+    """Run many scenes in parallel; per scene (arrays, statistics) or the exception it raised.
+    Ctrl-C stops every run (KeyboardInterrupt)."""

@@ -299,7 +299,7 @@ def _add_paper(p: argparse.ArgumentParser) -> None:
     try:
         from .simulation import INTEGRATORS
     except ImportError:  # pragma: no cover - a build without the simulation module
-        INTEGRATORS = None
+        INTEGRATORS = None  # type: ignore[assignment]
     p.add_argument("--integrator", default=None, metavar="NAME", choices=INTEGRATORS,
                    help="time integrator"
                    + (f": one of {', '.join(INTEGRATORS)}" if INTEGRATORS else "")

@@ -1,6 +1,6 @@
 """The paper's runs (``rvdyn paper``): idle and full load at 8328 deg/s, figures and a summary.
 
-Full load comes in two versions (design.md erratum 3): ``paper`` is the printed 4024.9 N m on
+Full load comes in two versions (docs/model.md#errata-of-the-paper, erratum 3): ``paper`` is the printed 4024.9 N m on
 the output (10.3 kW, not the stated 112 kW); ``rated`` is 43.9 kN m = 57 x 770.6 N m, the
 lossless output torque of 112 kW at 8328 deg/s.
 """
@@ -133,7 +133,7 @@ def figures(load: str, scene: Scene, result: Result, out: Path) -> list[Path]:
 def markdown(summaries: list[dict[str, Any]]) -> str:
     """The summaries as a Markdown report."""
     lines = ["# rvdyn: the paper's runs", "",
-             "Default scene (design.md section 7), input 8328 deg/s, step start from rest, rigid joints, "
+             "Default scene (docs/model.md#default-scene), input 8328 deg/s, step start from rest, rigid joints, "
              "IMPACT contacts with the paper's parameters.", "",
              "| quantity | " + " | ".join(s["load_case"] for s in summaries) + " | paper |",
              "|---|" + "---|" * len(summaries) + "---|"]
@@ -156,7 +156,7 @@ def markdown(summaries: list[dict[str, Any]]) -> str:
     row("energy balance residual (relative)", [f"{s['energy_balance']['relative_residual']:.2e}" for s in summaries])
     row("wall time [s]", [f"{s['wall_time_s']:.2f}" for s in summaries])
     lines += ["", "Moments are about the disc centre (about the ring centre they are 24/23 larger). "
-              "The number of loaded pins is what this unmodified profile gives (design.md erratum 6). "
+              "The number of loaded pins is what this unmodified profile gives (docs/model.md#errata-of-the-paper, erratum 6). "
               "The energy residual includes the energy that generalized-alpha (rho_inf = 0.8) damps "
               "numerically in the start impact: large relative to the tiny idle flows; "
               "`rvdyn paper --integrator dopri5` closes the balance to about 1e-6.", ""]

@@ -56,7 +56,8 @@ def _disc_outline(
     local = geometry.profile(phi)
     c, s = math.cos(angle), math.sin(angle)
     rot = np.array([[c, -s], [s, c]])
-    return local @ rot.T + centre
+    points: np.ndarray = local @ rot.T + centre
+    return points
 
 
 def plot_geometry(
@@ -102,7 +103,7 @@ def plot_geometry(
     if ax is None:
         fig, ax = new_figure()
     else:
-        fig = ax.figure
+        fig = ax.figure  # type: ignore[assignment]
     mm = 1e3
     samples = samples_per_lobe * g.lobes + 1
     discs = []
@@ -195,7 +196,7 @@ def plot_stiffness(
     if ax is None:
         fig, ax = new_figure((7.5, 5.0))
     else:
-        fig = ax.figure
+        fig = ax.figure  # type: ignore[assignment]
     colours = {"convex-convex": "tab:blue", "convex-concave": "tab:red"}
     peaks = []
     for cond in conditions:
@@ -210,7 +211,7 @@ def plot_stiffness(
             ax.plot(PAPER_STIFFNESS_WIDTH * 1e3, kp, "*", markersize=12, color=line.get_color(),
                     label=f"{cond}: paper's printed maximum")
     # Labels of the marked maxima, highest first, stacked so that they do not overlap.
-    for rank, (k_max, w_max, edge, colour) in enumerate(sorted(peaks, key=lambda p: -p[0])):
+    for rank, (k_max, w_max, edge, colour) in enumerate(sorted(peaks, key=lambda p: -p[0])):  # type: ignore[assignment]
         what = "largest value (range edge, no interior maximum)" if edge else "maximum"
         ax.annotate(
             f"{what}: {k_max:.3e} at {w_max * 1e3:.2f} mm",

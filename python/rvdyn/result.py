@@ -1,67 +1,126 @@
-"""Results of a dynamic run: numpy arrays (first axis = time), summaries, plots, ``.npz`` files."""
+"""Results of a dynamic run: numpy arrays (first axis = time), summaries, plots, ``.npz`` files.
+
+Every recorded channel is declared once, in Rust (``rvdyn._core.channels()``: name, group,
+shape, unit, dtype, doc); :class:`Result` exposes each as a typed attribute built from that
+registry.
+"""
 
 from __future__ import annotations
 
 import json
 import math
+import zipfile
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any, Generic, Iterable, TypeVar, overload
 
 import numpy as np
+from numpy.typing import NDArray
 
-from .errors import ParameterError
+from . import _core
+from .errors import ParameterError, RvdynError
 
-__all__ = ["Result"]
+__all__ = ["Result", "CHANNELS", "CHANNEL_SPECS"]
 
-# Attribute -> meaning, unit and per-sample shape (for the docs and __repr__).
-CHANNELS: dict[str, str] = {
-    "t": "sample time [s], (n,)",
-    "sun_angle": "sun (input) angle [rad], (n,)",
-    "sun_speed": "sun (input) speed [rad/s], (n,)",
-    "carrier_angle": "carrier (output) angle [rad], (n,)",
-    "carrier_speed": "carrier (output) speed [rad/s], (n,)",
-    "crank_angle": "absolute rotation angle of each crankshaft [rad], (n, cranks)",
-    "crank_speed": "absolute speed of each crankshaft [rad/s], (n, cranks)",
-    "disc_center": "disc centres about the reducer axis [m], (n, discs, 2)",
-    "disc_angle": "disc rotation angles [rad], (n, discs)",
-    "pin_force": "normal force of pin j on disc k [N], (n, discs, pins); j = paper pin j+1",
-    "pin_penetration": "penetration of pin j into disc k [m], (n, discs, pins)",
-    "pin_moment": "moment of pin j's force about disc k's centre [N m] (z component; about "
-    "the ring centre it is zp/zc times larger), (n, discs, pins)",
-    "loaded_pins": "number of pins in contact per disc, (n, discs)",
-    "pin_point": "contact point on the profile, fixed frame [m], (n, discs, pins, 2)",
-    "pin_normal": "unit outward profile normal at the contact, (n, discs, pins, 2)",
-    "mesh_force": "sun/planet mesh force along the line of action [N], (n, planets)",
-    "mesh_deflection": "mesh deflection along the line of action [m], (n, planets)",
-    "input_torque": "torque the drive applies to the input [N m], (n,)",
-    "kinetic_energy": "kinetic energy of the free bodies [J], (n,)",
-    "potential_energy": "elastic energy in the contacts [J], (n,)",
-    "input_work": "work done by the drive [J], (n,)",
-    "output_work": "work done against the load [J], (n,)",
-    "dissipated_energy": "energy dissipated by contact damping [J], (n,)",
-    "energy_residual": "E_kin + E_el - E0 - W_in + W_out + D [J] (0 for an exact integration), (n,)",
-}
+#: The channel registry of the core: name -> {name, group, shape, unit, dtype, doc}.
+CHANNEL_SPECS: dict[str, dict[str, Any]] = {c["name"]: dict(c) for c in _core.channels()}
+
+
+def _describe(spec: dict[str, Any]) -> str:
+    shape = ", ".join(("n",) + tuple(spec["shape"]))
+    return f"{spec['doc']} [{spec['unit']}], ({shape})"
+
+
+#: Channel name -> meaning, unit and shape (n = samples).
+CHANNELS: dict[str, str] = {name: _describe(spec) for name, spec in CHANNEL_SPECS.items()}
+
+_T = TypeVar("_T", bound=np.generic)
+
+
+class _Channel(Generic[_T]):
+    """A recorded channel of :class:`Result` (a read-only numpy array, first axis = time)."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        spec = CHANNEL_SPECS.get(name)
+        if spec is None:
+            raise RuntimeError(f"Result.{name} is not in the core's channel registry")
+        self.name = name
+        self.spec = spec
+        self.__doc__ = CHANNELS[name]
+
+    @overload
+    def __get__(self, obj: None, owner: type | None = None) -> _Channel[_T]: ...
+    @overload
+    def __get__(self, obj: Result, owner: type | None = None) -> NDArray[_T]: ...
+    def __get__(self, obj: Result | None, owner: type | None = None) -> _Channel[_T] | NDArray[_T]:
+        if obj is None:
+            return self
+        arrays = obj._arrays
+        if self.name in arrays:
+            return arrays[self.name]
+        if obj.error is not None:
+            raise AttributeError(f"channel {self.name!r} is missing: the run failed ({obj.error})")
+        raise AttributeError(
+            f"channel {self.name!r} was not recorded: ask for it with channels=[{self.spec['group']!r}, ...]"
+        )
 
 
 class Result:
-    """Recorded channels of one run. Each channel in :data:`CHANNELS` that was recorded is an
-    attribute holding a numpy array whose first axis is time; ``stats`` holds the integrator
-    statistics (steps, evaluations, wall_time [s], ...); ``scene`` the scene as a dict."""
+    """Recorded channels of one run.
 
-    def __init__(self, arrays: dict[str, np.ndarray], stats: dict[str, float], scene: dict[str, Any] | None = None,
-                 options: dict[str, Any] | None = None):
-        self._arrays = dict(arrays)
-        self.stats = dict(stats)
-        self.scene = scene or {}
-        self.options = options or {}
+    Each channel (see :data:`CHANNELS`) that was recorded is an attribute holding a numpy array
+    whose first axis is time; ``stats`` holds the integrator statistics (integer counts: steps,
+    evaluations, ...; ``dt`` [s] or None for an adaptive run; ``wall_time`` [s]); ``scene`` the
+    scene as a dict; ``options`` the options the run actually used (integrator, dt, atol, ...,
+    ``t_end``; ``point`` for a sweep). A run of :func:`rvdyn.sweep` that failed has ``ok``
+    False and its exception in ``error``.
+    """
 
-    def __getattr__(self, name: str) -> np.ndarray:
-        arrays = self.__dict__.get("_arrays", {})
-        if name in arrays:
-            return arrays[name]
-        if name in CHANNELS:
-            raise AttributeError(f"channel {name!r} was not recorded: ask for it with channels=[...]")
-        raise AttributeError(name)
+    t: _Channel[np.float64] = _Channel()
+    sun_angle: _Channel[np.float64] = _Channel()
+    sun_speed: _Channel[np.float64] = _Channel()
+    carrier_angle: _Channel[np.float64] = _Channel()
+    carrier_speed: _Channel[np.float64] = _Channel()
+    crank_angle: _Channel[np.float64] = _Channel()
+    crank_speed: _Channel[np.float64] = _Channel()
+    disc_center: _Channel[np.float64] = _Channel()
+    disc_angle: _Channel[np.float64] = _Channel()
+    pin_force: _Channel[np.float64] = _Channel()
+    pin_penetration: _Channel[np.float64] = _Channel()
+    pin_moment: _Channel[np.float64] = _Channel()
+    loaded_pins: _Channel[np.int64] = _Channel()
+    pin_point: _Channel[np.float64] = _Channel()
+    pin_normal: _Channel[np.float64] = _Channel()
+    mesh_force: _Channel[np.float64] = _Channel()
+    mesh_deflection: _Channel[np.float64] = _Channel()
+    input_torque: _Channel[np.float64] = _Channel()
+    kinetic_energy: _Channel[np.float64] = _Channel()
+    potential_energy: _Channel[np.float64] = _Channel()
+    input_work: _Channel[np.float64] = _Channel()
+    output_work: _Channel[np.float64] = _Channel()
+    dissipated_energy: _Channel[np.float64] = _Channel()
+    energy_residual: _Channel[np.float64] = _Channel()
+
+    def __init__(self, arrays: dict[str, NDArray[Any]], stats: dict[str, Any], scene: dict[str, Any] | None = None,
+                 options: dict[str, Any] | None = None, error: RvdynError | None = None):
+        unknown = set(arrays) - set(CHANNEL_SPECS)
+        if unknown:
+            raise ParameterError(f"unknown channels {sorted(unknown)}: the channels are {sorted(CHANNEL_SPECS)}")
+        self._arrays: dict[str, NDArray[Any]] = dict(arrays)
+        self.stats: dict[str, Any] = dict(stats)
+        self.scene: dict[str, Any] = scene or {}
+        self.options: dict[str, Any] = options or {}
+        self.error: RvdynError | None = error
+
+    @classmethod
+    def failed(cls, error: RvdynError, scene: dict[str, Any] | None = None,
+               options: dict[str, Any] | None = None) -> Result:
+        """The entry of a run that raised ``error`` (``ok`` False, no channels)."""
+        return cls({}, {}, scene, options, error)
+
+    @property
+    def ok(self) -> bool:
+        """Whether the run finished (False: see ``error``)."""
+        return self.error is None
 
     @property
     def channels(self) -> list[str]:
@@ -69,6 +128,8 @@ class Result:
         return sorted(self._arrays)
 
     def __repr__(self) -> str:
+        if self.error is not None:
+            return f"Result(failed: {type(self.error).__name__}: {self.error})"
         n = len(self._arrays.get("t", []))
         return f"Result({n} samples, t_end={float(self._arrays['t'][-1]) if n else 0:.4g} s, channels={self.channels})"
 
@@ -102,7 +163,10 @@ class Result:
         k = i0 + int(np.nonzero(remaining >= target)[0][-1])
         sign = math.copysign(1.0, rel[-1] - rel[i0])
         lo, hi = float(t[k]), float(t[min(k + 1, len(t) - 1)])
-        f = lambda x: sign * (rel[-1] - _hermite(x, t, rel, rel_speed)) - target  # noqa: E731
+
+        def f(x: float) -> float:
+            return float(sign * (rel[-1] - _hermite(x, t, rel, rel_speed)) - target)
+
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             if f(mid) >= 0:
@@ -152,18 +216,38 @@ class Result:
 
     # -------------------------------------------------------------------- files
     def save(self, path: str | Path) -> Path:
-        """Write all arrays, statistics, scene and options to a compressed ``.npz`` file."""
+        """Write all arrays, statistics, scene and options to a compressed ``.npz`` file
+        (metadata as standard JSON, no pickles)."""
+        if self.error is not None:
+            raise ParameterError(f"a failed run has nothing to save ({self.error})")
         p = Path(path)
-        meta = json.dumps({"stats": self.stats, "scene": self.scene, "options": self.options})
-        np.savez_compressed(p, __meta__=np.array(meta), **self._arrays)
+        try:
+            meta = json.dumps({"stats": self.stats, "scene": self.scene, "options": self.options}, allow_nan=False)
+        except ValueError as exc:
+            raise ParameterError(f"result metadata is not finite JSON: {exc}") from None
+        arrays: dict[str, Any] = {"__meta__": np.array(meta), **self._arrays}
+        np.savez_compressed(p, **arrays)
         return p if p.suffix == ".npz" else p.with_name(p.name + ".npz")
 
     @classmethod
-    def load(cls, path: str | Path) -> "Result":
-        """Read a file written by :meth:`save`."""
-        with np.load(Path(path), allow_pickle=False) as f:
-            meta = json.loads(str(f["__meta__"]))
-            arrays = {k: f[k] for k in f.files if k != "__meta__"}
+    def load(cls, path: str | Path) -> Result:
+        """Read a file written by :meth:`save` (never unpickles: ``allow_pickle=False``).
+
+        A file that is missing, damaged or not written by :meth:`save` raises
+        :class:`ParameterError` naming the file, with the original error chained.
+        """
+        p = Path(path)
+        try:
+            # The file is opened here so that it is closed also when numpy fails to read it.
+            with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as f:
+                if "__meta__" not in f.files:
+                    raise ValueError("no __meta__ entry: not a file written by Result.save")
+                meta = json.loads(str(f["__meta__"]))
+                if not isinstance(meta, dict):
+                    raise ValueError("__meta__ is not a JSON object")
+                arrays = {k: f[k] for k in f.files if k != "__meta__"}
+        except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as exc:
+            raise ParameterError(f"cannot read result file {str(p)!r}: {exc}") from exc
         return cls(arrays, meta.get("stats", {}), meta.get("scene"), meta.get("options"))
 
     # -------------------------------------------------------------------- plots

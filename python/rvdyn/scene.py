@@ -1,29 +1,18 @@
 """Reducer scenes: a validated, serialisable description of one reducer and its load case.
 
-A :class:`Scene` wraps a nested dictionary whose schema is defined (and validated) by the Rust
-core; every value is SI (m, kg, s, N, rad). Fields are addressed by dotted paths, with list
-indices as numbers: ``"load.torque"``, ``"discs.1.d_rrp"``, ``"cycloid.pin_radius"``.
-
-Top-level fields: ``name``; ``stage1`` (involute stage or ``None``); ``cycloid`` (pins,
-eccentricity, pin_circle_radius, pin_radius, face_width, d_rp, d_rrp, d_delta); ``discs`` (one
-or two ``{phase, d_rp, d_rrp, d_delta}``, the modifications overriding ``cycloid``'s);
-``cranks``; ``pin_errors`` (``position`` (zp, 2) [m], ``radius`` (zp,) [m]); ``density``;
-``inertias`` (``sun``/``crank``/``disc``/``carrier``: ``{mass, inertia}`` or ``None`` =
-computed from the geometry; ``load_inertia``); ``joints`` (``{"kind": "rigid"}``);
-``contact`` (``pin`` and ``mesh`` laws: ``{"kind": "impact", stiffness [N/m^e], exponent,
-max_damping [N s/m], damping_depth [m]}`` or ``{"kind": "palmgren", max_damping,
-damping_depth}``); ``drive`` (``{"kind": "speed", speed [rad/s], start: "step"|"ramp",
-ramp_time [s]}`` or ``{"kind": "torque", torque [N m], ramp_time}``); ``load`` (``idle``,
-``constant`` {torque}, ``step`` {before, after, time}, ``table`` {points: [[t, torque], ...]});
-``initial`` (``"rest"`` or ``"steady"``).
+A :class:`Scene` owns a scene compiled by the Rust core (``rvdyn._core.CompiledScene``): the
+schema exists once, in Rust, and is validated once, when the scene is built; :func:`simulate`
+and :func:`sweep` take the compiled scene as it is. Every value is SI (m, kg, s, N, rad).
+Fields are addressed by dotted paths, with list indices as numbers: ``"load.torque"``,
+``"discs.1.d_rrp"``, ``"cycloid.pin_radius"``. Every field, with its unit, default and rule, is
+listed in ``docs/scene.md`` (generated from the code).
 """
 
 from __future__ import annotations
 
-import copy
 import json
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn, final
 
 from . import _core
 from .errors import SceneError
@@ -31,47 +20,99 @@ from .errors import SceneError
 __all__ = ["Scene"]
 
 
-def _split(path: str) -> list[str | int]:
-    if not isinstance(path, str) or not path:
-        raise SceneError(f"a scene field path must be a non-empty string like 'load.torque', got {path!r}")
-    return [int(p) if p.isdigit() else p for p in path.split(".")]
+
+def _plain(value: Any) -> Any:
+    """numpy scalars and arrays as Python numbers and lists (for JSON)."""
+    if hasattr(value, "tolist") and callable(value.tolist):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not a number, string, list or dict")
 
 
+def _json_value(path: str, value: Any) -> str:
+    try:
+        return json.dumps(value, allow_nan=False, default=_plain)
+    except (TypeError, ValueError) as exc:
+        raise SceneError(
+            f"scene field {path!r}: values must be numbers, strings, lists or dicts without NaN/inf ({exc})"
+        ) from None
+
+
+@final
 class Scene:
-    """One reducer with its drive, load and initial state (validated on construction).
+    """One reducer with its drive, load and initial state, validated on construction.
 
-    Build one with :meth:`Scene.paper` and change fields with :meth:`replace`; scenes are
-    immutable values (``replace`` returns a new, validated scene).
+    Build one with :meth:`Scene.paper`, from a dict (``Scene(data)``), or from a file
+    (:meth:`load`, :meth:`from_json`, :meth:`from_toml`); change fields with :meth:`replace`.
+    Scenes are immutable values: equal scenes compare and hash equal, and they pickle.
 
     >>> s = Scene.paper("rated").replace(**{"cycloid.d_rrp": 2e-5, "initial": "steady"})
-    >>> s["load.torque"]  # N m
-    43922.7...
+    >>> round(s["load.torque"], 1)  # N m
+    43921.3
+    >>> s == Scene.from_json(s.to_json())
+    True
     """
 
-    __slots__ = ("_data",)
+    __slots__ = ("_compiled",)
+    _compiled: _core.CompiledScene
 
     def __init__(self, data: dict[str, Any]):
         if not isinstance(data, dict):
             raise SceneError(f"a scene is built from a dict, got {type(data).__name__}")
-        try:
-            text = json.dumps(data, allow_nan=False)
-        except (TypeError, ValueError) as exc:
-            raise SceneError(f"scene values must be numbers, strings, lists or dicts without NaN/inf: {exc}") from None
-        self._data: dict[str, Any] = json.loads(_core.scene_validate(text))
+        object.__setattr__(self, "_compiled", _core.CompiledScene.from_json(_json_value("scene", data)))
 
     @classmethod
-    def paper(cls, load: str = "paper", /, **changes: Any) -> "Scene":
-        """The default scene (design.md section 7) at 8328 deg/s with a step start from rest.
+    def _wrap(cls, compiled: _core.CompiledScene) -> Scene:
+        scene = cls.__new__(cls)
+        object.__setattr__(scene, "_compiled", compiled)
+        return scene
+
+    def __setattr__(self, name: str, value: object) -> NoReturn:
+        raise AttributeError("Scene is immutable: use scene.replace(...) for a changed copy")
+
+    def __delattr__(self, name: str) -> NoReturn:
+        raise AttributeError("Scene is immutable")
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def paper(cls, load: str = "paper", /, **changes: Any) -> Scene:
+        """The default scene (``docs/model.md#default-scene``) at 8328 deg/s with a step start
+        from rest.
 
         ``load``: ``"idle"``, ``"paper"`` (the printed 4024.9 N m on the output) or
-        ``"rated"`` (43.9 kN m = 57 x 770.6 N m, consistent with 112 kW). ``changes``: dotted
-        field paths and values, as for :meth:`replace`.
+        ``"rated"`` (43.9 kN m = 57 x 770.6 N m, consistent with 112 kW); positional, or as
+        the keyword ``load=``. ``changes``: dotted field paths and values, as for
+        :meth:`replace`.
+
+        >>> Scene.paper(load="rated") == Scene.paper("rated")
+        True
         """
-        scene = cls(json.loads(_core.scene_paper(load)))
+        if "load" in changes and not isinstance(changes["load"], dict):
+            # Scene.paper(load="rated"): the load case given by keyword (issue 12, D10).
+            if load != "paper":
+                raise SceneError(
+                    "give the load case once: Scene.paper('rated') or Scene.paper(load='rated')"
+                )
+            load = changes.pop("load")
+        if not isinstance(load, str):
+            raise SceneError(
+                f"the load case must be 'idle', 'paper' or 'rated' (Scene.paper('rated')), got {load!r}; "
+                "to set a load law use Scene.paper().replace(load={'kind': 'constant', 'torque': ...})"
+            )
+        scene = cls._wrap(_core.CompiledScene.paper(load))
         return scene.replace(**changes) if changes else scene
 
+    @classmethod
+    def from_json(cls, text: str) -> Scene:
+        """A scene from JSON text (the schema of ``docs/scene.md``; unknown fields are errors)."""
+        return cls._wrap(_core.CompiledScene.from_json(text))
+
+    @classmethod
+    def from_toml(cls, text: str) -> Scene:
+        """A scene from TOML text."""
+        return cls._wrap(_core.CompiledScene.from_toml(text))
+
     def with_compliant_joints(self, eccentric_bearing: dict[str, float] | None = None,
-                              crank_bearing: dict[str, float] | str | None = None) -> "Scene":
+                              crank_bearing: dict[str, float] | str | None = None) -> Scene:
         """This scene with compliant joints: spring-damper bearings between each eccentric and
         its disc hole and between each crank and the carrier (``{stiffness [N/m], damping
         [N s/m], clearance [m]}``, changes to the defaults); the discs and crank centres then
@@ -90,85 +131,78 @@ class Scene:
             joints["crank_bearing"].update(crank_bearing)
         return self.replace(joints=joints)
 
-    def to_dict(self) -> dict[str, Any]:
-        """A deep copy of the scene as a plain dictionary (SI values)."""
-        return copy.deepcopy(self._data)
-
-    def to_json(self) -> str:
-        """The scene as JSON text."""
-        return json.dumps(self._data, indent=2)
-
-    def __getitem__(self, path: str) -> Any:
-        """Value of a dotted field path, e.g. ``scene["load.torque"]``."""
-        node: Any = self._data
-        for key in _split(path):
-            try:
-                node = node[key]
-            except (KeyError, IndexError, TypeError):
-                raise SceneError(f"scene has no field {path!r} (at {key!r})") from None
-        return copy.deepcopy(node)
-
-    def replace(self, **changes: Any) -> "Scene":
+    def replace(self, **changes: Any) -> Scene:
         """A new scene with fields changed; keys are dotted paths (pass them with ``**{...}``).
 
         Setting a whole sub-dictionary (e.g. ``load={"kind": "constant", "torque": 1e3}``)
-        replaces it. The result is validated: a wrong value raises :class:`SceneError` or
-        :class:`GeometryError` naming the field.
+        replaces it. The result is validated (in Rust): a wrong value or an unknown field
+        raises :class:`SceneError` or :class:`GeometryError` naming the field.
         """
-        data = self.to_dict()
-        for path, value in changes.items():
-            keys = _split(path)
-            node: Any = data
-            for key in keys[:-1]:
-                try:
-                    node = node[key]
-                except (KeyError, IndexError, TypeError):
-                    raise SceneError(f"scene has no field {path!r} (at {key!r})") from None
-            last = keys[-1]
-            if isinstance(node, dict) or (isinstance(node, list) and isinstance(last, int) and last < len(node)):
-                node[last] = copy.deepcopy(value)
-            else:
-                raise SceneError(f"scene has no field {path!r}")
-        return Scene(data)
+        if not changes:
+            return self
+        items = [(path, _json_value(path, value)) for path, value in changes.items()]
+        return Scene._wrap(self._compiled.replace(items))
+
+    # ------------------------------------------------------------------ reading
+    def __getitem__(self, path: str) -> Any:
+        """Value of a dotted field path, e.g. ``scene["load.torque"]`` (a copy)."""
+        if not isinstance(path, str):
+            raise SceneError(f"a scene field path must be a string like 'load.torque', got {path!r}")
+        return json.loads(self._compiled.get(path))
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scene as a plain dictionary (SI values; a copy)."""
+        data: dict[str, Any] = json.loads(self._compiled.to_json(indent=False))
+        return data
+
+    def to_json(self) -> str:
+        """The scene as JSON text."""
+        return self._compiled.to_json()
+
+    def to_toml(self) -> str:
+        """The scene as TOML text."""
+        return self._compiled.to_toml()
 
     def save(self, path: str | Path) -> Path:
         """Write the scene to ``path``: TOML for ``.toml``, JSON otherwise. Returns the path."""
         p = Path(path)
-        text = _core.scene_to_toml(json.dumps(self._data)) if p.suffix == ".toml" else self.to_json()
+        text = self.to_toml() if p.suffix == ".toml" else self.to_json()
         p.write_text(text, encoding="utf-8")
         return p
 
     @classmethod
-    def load(cls, path: str | Path) -> "Scene":
+    def load(cls, path: str | Path) -> Scene:
         """Read a scene written by :meth:`save` (TOML for ``.toml``, JSON otherwise)."""
         p = Path(path)
         try:
             text = p.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise SceneError(f"cannot read scene file {str(p)!r}: {exc.strerror}") from None
-        if p.suffix == ".toml":
-            return cls(json.loads(_core.scene_from_toml(text)))
+        except (OSError, UnicodeDecodeError) as exc:
+            raise SceneError(f"cannot read scene file {str(p)!r}: {exc}") from exc
         try:
-            return cls(json.loads(text))
-        except json.JSONDecodeError as exc:
-            raise SceneError(f"scene file {str(p)!r} is not valid JSON: {exc}") from None
+            return cls.from_toml(text) if p.suffix == ".toml" else cls.from_json(text)
+        except SceneError as exc:
+            raise SceneError(f"scene file {str(p)!r}: {exc}") from exc
 
     def model_info(self) -> dict[str, Any]:
         """Mass properties the model uses (computed ones included) [kg, kg m^2], the
         generalised masses of (carrier, crank, sun), crank radius [m], ratio and DOF count."""
-        return dict(_core.scene_model_info(json.dumps(self._data)))
+        return dict(self._compiled.model_info())
 
     @property
     def ratio(self) -> float:
         """Transmission ratio input speed / output speed (57 for the paper)."""
         return float(self.model_info()["ratio"])
 
+    # ------------------------------------------------------------------ value semantics
     def __eq__(self, other: object) -> bool:
-        return isinstance(other, Scene) and self._data == other._data
+        return isinstance(other, Scene) and self._compiled == other._compiled
 
     def __hash__(self) -> int:
-        return hash(json.dumps(self._data, sort_keys=True))
+        return hash(self._compiled)
+
+    def __reduce__(self) -> tuple[Any, tuple[str]]:
+        return (Scene.from_json, (self._compiled.to_json(indent=False),))
 
     def __repr__(self) -> str:
-        load = self._data.get("load", {})
-        return f"Scene(name={self._data.get('name')!r}, load={load}, joints={self._data.get('joints', {}).get('kind')!r})"
+        d = self.to_dict()
+        return f"Scene(name={d.get('name')!r}, load={d.get('load')}, joints={d.get('joints', {}).get('kind')!r})"

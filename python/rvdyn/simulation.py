@@ -1,46 +1,64 @@
-"""Dynamic runs: :func:`simulate` one scene, :func:`sweep` many in parallel."""
+"""Dynamic runs: :func:`simulate` one scene, :func:`sweep` many in parallel.
+
+Run options live in one object, :class:`rvdyn.Options` (built and validated in Rust); the
+keyword arguments of :func:`simulate` and :func:`sweep` are a convenience mapped onto it in one
+place (:func:`_resolve_options`).
+"""
 
 from __future__ import annotations
 
 import itertools
 import json
+import operator
 import sys
 from typing import Any, Iterable, Mapping, Sequence
 
 from . import _core
-from .errors import ParameterError
+from ._core import Options
+from .errors import ParameterError, RvdynError
 from .result import Result
 from .scene import Scene
 
-__all__ = ["simulate", "sweep", "INTEGRATORS"]
+__all__ = ["simulate", "sweep", "Options", "INTEGRATORS"]
 
-#: Integrator names accepted by :func:`simulate`.
-INTEGRATORS = ("generalized-alpha", "dopri5", "rk4")
+#: Integrator names accepted by :func:`simulate` (the Rust registry, default first).
+INTEGRATORS: tuple[str, ...] = tuple(name for name, *_ in _core.integrators())
 
 
-def _check_scene(scene: Any) -> Scene:
+def _check_scene(scene: object) -> Scene:
     if not isinstance(scene, Scene):
         raise ParameterError(f"scene must be an rvdyn.Scene (e.g. rvdyn.Scene.paper()), got {type(scene).__name__}")
     return scene
 
 
-def _options(t_end: float, integrator: str, dt: float | None, rtol: float | None, atol: float | None,
-             rho_inf: float | None, record_interval: float | None, max_samples: int | None,
-             channels: Sequence[str] | None) -> dict[str, Any]:
-    if isinstance(channels, str):
-        channels = [channels]
-    return {"t_end": float(t_end), "integrator": str(integrator), "dt": dt, "rtol": rtol, "atol": atol,
-            "rho_inf": rho_inf, "record_interval": record_interval, "max_samples": max_samples,
-            "channels": None if channels is None else list(channels)}
+def _resolve_options(options: Options | None, integrator: str | None, changes: dict[str, Any]) -> Options:
+    """The options of a call: ``options`` (or the defaults) with the keyword arguments given
+    (those not None) applied; validated in Rust."""
+    given = {k: v for k, v in changes.items() if v is not None}
+    if integrator is not None:
+        given["integrator"] = integrator
+    if options is None:
+        return Options(**given)
+    if not isinstance(options, Options):
+        raise ParameterError(f"options must be an rvdyn.Options, got {type(options).__name__}")
+    return options.replace(**given) if given else options
 
 
-def simulate(scene: Scene, t_end: float, integrator: str = "generalized-alpha", *, dt: float | None = None,
-             rtol: float | None = None, atol: float | None = None, rho_inf: float | None = None,
-             record_interval: float | None = None, max_samples: int | None = None,
-             channels: Sequence[str] | None = None, progress: bool | None = None,
-             skip_separated: bool = True) -> Result:
+def _t_end(t_end: object) -> float:
+    try:
+        return float(t_end)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ParameterError(f"t_end must be a time in s, got {t_end!r}") from None
+
+
+def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, options: Options | None = None,
+             dt: float | None = None, rtol: float | None = None, atol: float | None = None,
+             rho_inf: float | None = None, record_interval: float | None = None, max_samples: int | None = None,
+             channels: Sequence[str] | str | None = None, progress: bool | None = None,
+             skip_separated: bool | None = None) -> Result:
     """Simulate ``scene`` from t = 0 to ``t_end`` [s] and return the recorded :class:`Result`.
 
+    options: an :class:`rvdyn.Options`; the keyword arguments below, when given, change it.
     integrator: ``"generalized-alpha"`` (implicit, order 2, fixed step ``dt``, default 1e-4 s;
     ``rho_inf`` in [0, 1] sets its high-frequency damping, default 0.8; ``atol`` [m] is its
     Newton tolerance on displacements, default 1e-9 m), ``"dopri5"``
@@ -58,16 +76,21 @@ def simulate(scene: Scene, t_end: float, integrator: str = "generalized-alpha", 
 
     The core runs with the GIL released; Ctrl-C stops it cleanly (``KeyboardInterrupt``). A run
     that goes unstable raises :class:`rvdyn.SimulationError` saying when and what would help.
+
+    >>> res = simulate(Scene.paper("rated"), 1e-3, dt=1e-4)
+    >>> res.t.shape, res.options["integrator"], res.stats["steps"]
+    ((11,), 'generalized-alpha', 10)
     """
     scene = _check_scene(scene)
-    opts = _options(t_end, integrator, dt, rtol, atol, rho_inf, record_interval, max_samples, channels)
+    opts = _resolve_options(options, integrator, {
+        "dt": dt, "rtol": rtol, "atol": atol, "rho_inf": rho_inf, "record_interval": record_interval,
+        "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated})
+    t = _t_end(t_end)
     if progress is None:
         progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
-    arrays, stats = _core.simulate(scene.to_json(), opts["t_end"], opts["integrator"], dt=dt, rtol=rtol,
-                                   atol=atol, rho_inf=rho_inf, record_interval=record_interval,
-                                   max_samples=max_samples, channels=opts["channels"], progress=bool(progress),
-                                   skip_separated=bool(skip_separated))
-    return Result(arrays, stats, scene.to_dict(), opts)
+    used = opts.resolved(t)
+    arrays, stats = _core.simulate(scene._compiled, t, opts, progress=bool(progress))
+    return Result(arrays, stats, scene.to_dict(), used)
 
 
 def _grid(base: Scene, grid: Mapping[str, Iterable[Any]]) -> tuple[list[Scene], list[dict[str, Any]]]:
@@ -81,19 +104,25 @@ def _grid(base: Scene, grid: Mapping[str, Iterable[Any]]) -> tuple[list[Scene], 
     return scenes, points
 
 
-def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str = "generalized-alpha", *,
-          grid: Mapping[str, Iterable[Any]] | None = None, threads: int | None = None,
-          dt: float | None = None, rtol: float | None = None, atol: float | None = None,
-          rho_inf: float | None = None, record_interval: float | None = None, max_samples: int | None = None,
-          channels: Sequence[str] | None = None, skip_separated: bool = True) -> list[Result | Exception]:
-    """Run many scenes in parallel (Rust threads, GIL released) and return one entry per
-    scene, in order: a :class:`Result`, or the exception that run raised (a failed run does not
-    stop the others).
+def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None = None, *,
+          options: Options | None = None, grid: Mapping[str, Iterable[Any]] | None = None,
+          threads: int | None = None, dt: float | None = None, rtol: float | None = None,
+          atol: float | None = None, rho_inf: float | None = None, record_interval: float | None = None,
+          max_samples: int | None = None, channels: Sequence[str] | str | None = None,
+          skip_separated: bool | None = None) -> list[Result]:
+    """Run many scenes in parallel (Rust threads, GIL released) and return one :class:`Result`
+    per scene, in order. A run that failed has ``ok`` False and its exception in ``error``
+    (a failed run does not stop the others); bad options raise before any run, as for
+    :func:`simulate`. Ctrl-C stops every run and raises ``KeyboardInterrupt``.
 
     ``scenes`` is a list of scenes, or one base scene with ``grid`` mapping dotted field paths
     to values (the full Cartesian product is run; each result's ``options["point"]`` holds its
     field values). ``threads``: worker threads (default: all cores). Other options as for
     :func:`simulate`.
+
+    >>> runs = sweep(Scene.paper("rated"), 1e-3, grid={"load.torque": [1e4, 2e4]}, dt=1e-4)
+    >>> [r.ok for r in runs], runs[1].options["point"]
+    ([True, True], {'load.torque': 20000.0})
     """
     if isinstance(scenes, Scene):
         if not grid:
@@ -104,15 +133,28 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str = "gene
             raise ParameterError("give either a list of scenes or one scene with a grid, not both")
         scene_list = [_check_scene(s) for s in scenes]
         points = [{} for _ in scene_list]
-    opts = _options(t_end, integrator, dt, rtol, atol, rho_inf, record_interval, max_samples, channels)
-    raw = _core.sweep([s.to_json() for s in scene_list], opts["t_end"], opts["integrator"], dt=dt, rtol=rtol,
-                      atol=atol, rho_inf=rho_inf, record_interval=record_interval, max_samples=max_samples,
-                      channels=opts["channels"], threads=threads, skip_separated=bool(skip_separated))
-    out: list[Result | Exception] = []
+    opts = _resolve_options(options, integrator, {
+        "dt": dt, "rtol": rtol, "atol": atol, "rho_inf": rho_inf, "record_interval": record_interval,
+        "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated})
+    t = _t_end(t_end)
+    used = opts.resolved(t)
+    if threads is not None:
+        try:
+            if isinstance(threads, bool):
+                raise TypeError
+            threads = operator.index(threads)  # Python and numpy integers
+        except TypeError:
+            raise ParameterError(f"threads must be a whole number >= 1 (None = one per core), got {threads!r}") from None
+        if threads < 1:
+            raise ParameterError(f"threads must be a whole number >= 1 (None = one per core), got {threads!r}")
+    raw = _core.sweep([s._compiled for s in scene_list], t, opts, threads=threads)
+    out: list[Result] = []
     for scene, point, item in zip(scene_list, points, raw):
+        run_options = {**used, "point": json.loads(json.dumps(point))}
         if isinstance(item, BaseException):
-            out.append(item)  # type: ignore[arg-type]
+            error = item if isinstance(item, RvdynError) else RvdynError(str(item))
+            out.append(Result.failed(error, scene.to_dict(), run_options))
         else:
             arrays, stats = item
-            out.append(Result(arrays, stats, scene.to_dict(), {**opts, "point": json.loads(json.dumps(point))}))
+            out.append(Result(arrays, stats, scene.to_dict(), run_options))
     return out

@@ -1,5 +1,5 @@
 //! Classical quasi-static load sharing of an unmodified cycloid disc (Kudryavtsev; Li Lixing):
-//! a reference for the dynamic pin forces (notes/physics.md section 2.1).
+//! a reference for the dynamic pin forces (docs/validation.md).
 //!
 //! With rigid pins and housing and a linear contact law, a disc turning by a small angle
 //! `beta` about its centre deforms pin `j` by `beta l_j`, where `l_j = rc' sin(phi_j) / S_j` is

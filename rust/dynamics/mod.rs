@@ -1,17 +1,22 @@
-//! Scenes, the equations of motion and the simulation driver.
+//! Scenes, the equations of motion and the simulation driver, in the order data flows:
+//!
+//! - [`scene`]: the reducer description (schema, validation, the paper's preset);
+//! - [`model`]: the equations of motion built from a scene: the parts shared by both models,
+//!   the rigid-joint and the compliant-joint model, the contact and bearing laws;
+//! - [`run`]: the driver that integrates a model with a registered integrator
+//!   ([`crate::solve`]) and records the channels into a [`Recording`].
 
-pub mod compliant;
-pub mod drive;
+#![warn(missing_docs)]
+
 pub mod model;
-pub mod pin_contact;
-pub mod record;
-pub mod rigid;
+pub mod run;
 pub mod scene;
-pub mod simulate;
-pub mod sink;
-pub mod system;
 
-pub use record::Recording;
-pub use rigid::RigidModel;
+// Paths kept for code written against the flat layout.
+pub use model::{compliant, drive, pin_contact, rigid, rigid_system as system};
+pub use run::{driver as simulate, recorder as record, sink};
+
+pub use model::rigid::RigidModel;
+pub use run::driver::{RunControl, SimOptions, run, simulate};
+pub use run::recorder::Recording;
 pub use scene::Scene;
-pub use simulate::{RunControl, SimOptions, simulate};

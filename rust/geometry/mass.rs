@@ -14,7 +14,9 @@ pub const STEEL_DENSITY: f64 = 7850.0;
 /// Mass [kg] and moment of inertia about the body's own axis [kg m^2].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MassProperties {
+    /// Mass [kg].
     pub mass: f64,
+    /// Moment of inertia about the body's own axis [kg m^2].
     pub inertia: f64,
 }
 
@@ -27,9 +29,11 @@ pub struct DiscHoles {
     pub hole_circle_radius: f64,
     /// Number of crank (eccentric bearing) holes and their radius [m].
     pub crank_holes: u32,
+    /// Radius of each crank hole [m].
     pub crank_hole_radius: f64,
     /// Number of pillar holes (between the crank holes) and their radius [m].
     pub pillar_holes: u32,
+    /// Radius of each pillar hole [m].
     pub pillar_hole_radius: f64,
 }
 

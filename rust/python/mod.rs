@@ -12,6 +12,7 @@ mod contact;
 mod errors;
 mod geometry;
 mod kinematics;
+mod scene;
 mod simulate;
 
 use numpy::ndarray::{ArrayD, IxDyn};
@@ -211,6 +212,7 @@ fn rvdyn_core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     geometry::register(m)?;
     contact::register(m)?;
     kinematics::register(m)?;
+    scene::register(m)?;
     simulate::register(m)?;
     Ok(())
 }

@@ -1,196 +1,391 @@
-//! Bindings for scenes and dynamic runs. The Python `rvdyn.Scene`, `rvdyn.simulate` and
-//! `rvdyn.Result` (python/rvdyn/) wrap these private functions.
+//! Bindings for dynamic runs: the run options (`rvdyn.Options`), `simulate` and `sweep`. The
+//! Python `rvdyn.simulate`, `rvdyn.sweep` and `rvdyn.Result` (python/rvdyn/) wrap these.
 
-use crate::dynamics::compliant::{CompliantModel, default_joints};
-use crate::dynamics::record::{Channel, Recording};
-use crate::dynamics::rigid::RigidModel;
-use crate::dynamics::scene::{Joints, Scene};
-use crate::dynamics::simulate::{RunControl, SimOptions};
+use super::scene::CompiledScene;
+use crate::dynamics::run::driver::{RunControl, SimOptions};
+use crate::dynamics::run::recorder::{CHANNELS, Channel, Dtype, Recording};
+use crate::dynamics::scene::Scene;
 use crate::error::RvdynError;
-use crate::solve::MechanicalSystem;
-use crate::solve::Method;
+use crate::solve::{INTEGRATORS, Method};
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 use std::io::Write;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-fn scene(json: &str) -> PyResult<Scene> {
-    Ok(Scene::from_json(json)?)
+/// Most worker threads a sweep may ask for.
+const MAX_THREADS: usize = 1024;
+
+/// Options of a run (all but the end time), validated when built. `rvdyn.Options`.
+#[pyclass(name = "Options", module = "rvdyn", frozen, eq)]
+#[derive(Clone, PartialEq)]
+pub(crate) struct Options {
+    inner: SimOptions,
 }
 
-/// The default scene of design.md section 7 as JSON; `load` is "idle", "paper" or "rated".
-#[pyfunction]
-fn scene_paper(load: &str) -> PyResult<String> {
-    Ok(Scene::paper(load)?.to_json()?)
-}
-
-/// Validate a scene given as JSON; returns it normalised (defaults filled in) as JSON.
-#[pyfunction]
-fn scene_validate(json: &str) -> PyResult<String> {
-    Ok(scene(json)?.to_json()?)
-}
-
-/// Scene JSON -> TOML text.
-#[pyfunction]
-fn scene_to_toml(json: &str) -> PyResult<String> {
-    Ok(scene(json)?.to_toml()?)
-}
-
-/// TOML text -> scene JSON (validated).
-#[pyfunction]
-fn scene_from_toml(text: &str) -> PyResult<String> {
-    Ok(Scene::from_toml(text)?.to_json()?)
-}
-
-/// The default compliant joints (assumed bearing stiffness and damping) as JSON.
-#[pyfunction]
-fn default_compliant_joints() -> PyResult<String> {
-    serde_json::to_string(&default_joints())
-        .map_err(|e| crate::python::parameter_error(format!("cannot write joints: {e}")))
-}
-
-/// Mass properties and generalised masses the model uses for a scene (SI).
-#[pyfunction]
-fn scene_model_info<'py>(py: Python<'py>, json: &str) -> PyResult<Bound<'py, PyDict>> {
-    let sc = scene(json)?;
-    let dof = match sc.joints {
-        Joints::Rigid => None,
-        Joints::Compliant { .. } => Some(CompliantModel::new(&sc)?.dof()),
+/// Set one option from a Python value: the one place where option names map to fields.
+fn set_option(o: &mut SimOptions, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+    let none = value.is_none();
+    let float = |what: &str| -> PyResult<f64> {
+        value.extract::<f64>().map_err(|_| {
+            crate::python::parameter_error(format!(
+                "{key} must be a number ({what}), got {}",
+                value.repr().map(|r| r.to_string()).unwrap_or_default()
+            ))
+        })
     };
-    let mut rigid = sc.clone();
-    rigid.joints = Joints::Rigid;
-    let model = RigidModel::new(&rigid)?;
-    let d = PyDict::new(py);
-    let i = model.inertias;
-    for (name, mp) in [
-        ("sun", i.sun),
-        ("crank", i.crank),
-        ("disc", i.disc),
-        ("carrier", i.carrier),
-    ] {
-        d.set_item(format!("{name}_mass"), mp.mass)?;
-        d.set_item(format!("{name}_inertia"), mp.inertia)?;
+    match key {
+        "integrator" => {
+            let name: String = value.extract().map_err(|_| {
+                crate::python::parameter_error("integrator must be a name such as \"rk4\"")
+            })?;
+            o.method = Method::parse(&name)?;
+        }
+        "dt" => o.dt = if none { None } else { Some(float("s")?) },
+        "rtol" => o.rtol = float("relative")?,
+        "atol" => o.atol = float("m")?,
+        "rho_inf" => o.rho_inf = float("in [0, 1]")?,
+        "record_interval" => o.record_interval = if none { None } else { Some(float("s")?) },
+        "max_samples" => {
+            let n: i64 = value.extract().map_err(|_| {
+                crate::python::parameter_error("max_samples must be a whole number >= 2")
+            })?;
+            o.max_samples = usize::try_from(n).unwrap_or(0);
+        }
+        "channels" => {
+            o.channels = if none {
+                Channel::defaults()
+            } else if let Ok(one) = value.extract::<String>() {
+                vec![Channel::parse(&one)?]
+            } else {
+                let names: Vec<String> = value.extract().map_err(|_| {
+                    crate::python::parameter_error(
+                        "channels must be a list of names such as [\"motion\", \"pins\"]",
+                    )
+                })?;
+                names
+                    .iter()
+                    .map(|c| Channel::parse(c))
+                    .collect::<Result<_, _>>()?
+            }
+        }
+        "skip_separated" => {
+            o.skip_separated = value.is_truthy()?;
+        }
+        _ => {
+            return Err(crate::python::parameter_error(format!(
+                "unknown option {key:?}: the options are integrator, dt, rtol, atol, rho_inf, \
+                 record_interval, max_samples, channels, skip_separated"
+            )));
+        }
     }
-    d.set_item("load_inertia", i.load_inertia)?;
-    d.set_item("generalized_mass", model.mass.to_vec())?;
-    d.set_item("crank_radius", model.crank_radius)?;
-    d.set_item("ratio", model.ratio)?;
-    d.set_item("max_penetration", model.max_penetration)?;
-    d.set_item("dof", dof.unwrap_or(model.free.len()))?;
-    d.set_item("joints", if dof.is_some() { "compliant" } else { "rigid" })?;
+    Ok(())
+}
+
+/// The arguments given (not None) as a dict for [`apply`].
+fn given<'py, const N: usize>(
+    py: Python<'py>,
+    args: [(&str, Option<Bound<'py, PyAny>>); N],
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (k, v) in args {
+        if let Some(v) = v.filter(|v| !v.is_none()) {
+            d.set_item(k, v)?;
+        }
+    }
     Ok(d)
 }
 
-/// Options of a run, as passed from Python.
-#[allow(clippy::too_many_arguments)]
-fn options(
-    t_end: f64,
-    integrator: &str,
-    dt: Option<f64>,
-    rtol: Option<f64>,
-    atol: Option<f64>,
-    rho_inf: Option<f64>,
-    record_interval: Option<f64>,
-    max_samples: Option<usize>,
-    channels: Option<Vec<String>>,
-    skip_separated: bool,
-) -> Result<SimOptions, RvdynError> {
-    let mut o = SimOptions::new(t_end, Method::parse(integrator)?);
-    o.dt = dt;
-    if let Some(v) = rtol {
-        o.rtol = v;
+fn apply(mut o: SimOptions, changes: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
+    if let Some(changes) = changes {
+        for (k, v) in changes.iter() {
+            set_option(&mut o, &k.extract::<String>()?, &v)?;
+        }
     }
-    if let Some(v) = atol {
-        o.atol = v;
+    o.validate_settings()?;
+    Ok(Options { inner: o })
+}
+
+impl Options {
+    /// The options for a run to `t_end` [s], checked.
+    fn for_run(&self, t_end: f64) -> Result<SimOptions, RvdynError> {
+        let mut o = self.inner.clone();
+        o.t_end = t_end;
+        o.validate()?;
+        Ok(o)
     }
-    if let Some(v) = rho_inf {
-        o.rho_inf = v;
+}
+
+#[pymethods]
+impl Options {
+    #[new]
+    #[pyo3(signature = (integrator = None, *, dt = None, rtol = None, atol = None, rho_inf = None,
+        record_interval = None, max_samples = None, channels = None, skip_separated = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn py_new<'py>(
+        py: Python<'py>,
+        integrator: Option<Bound<'py, PyAny>>,
+        dt: Option<Bound<'py, PyAny>>,
+        rtol: Option<Bound<'py, PyAny>>,
+        atol: Option<Bound<'py, PyAny>>,
+        rho_inf: Option<Bound<'py, PyAny>>,
+        record_interval: Option<Bound<'py, PyAny>>,
+        max_samples: Option<Bound<'py, PyAny>>,
+        channels: Option<Bound<'py, PyAny>>,
+        skip_separated: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Self> {
+        let given = given(
+            py,
+            [
+                ("integrator", integrator),
+                ("dt", dt),
+                ("rtol", rtol),
+                ("atol", atol),
+                ("rho_inf", rho_inf),
+                ("record_interval", record_interval),
+                ("max_samples", max_samples),
+                ("channels", channels),
+                ("skip_separated", skip_separated),
+            ],
+        )?;
+        apply(SimOptions::new(1.0, Method::GeneralizedAlpha), Some(&given))
     }
-    o.record_interval = record_interval;
-    if let Some(v) = max_samples {
-        o.max_samples = v;
+
+    /// A copy with the options given (not None) changed; same names as the constructor.
+    #[pyo3(signature = (*, integrator = None, dt = None, rtol = None, atol = None, rho_inf = None,
+        record_interval = None, max_samples = None, channels = None, skip_separated = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn replace<'py>(
+        &self,
+        py: Python<'py>,
+        integrator: Option<Bound<'py, PyAny>>,
+        dt: Option<Bound<'py, PyAny>>,
+        rtol: Option<Bound<'py, PyAny>>,
+        atol: Option<Bound<'py, PyAny>>,
+        rho_inf: Option<Bound<'py, PyAny>>,
+        record_interval: Option<Bound<'py, PyAny>>,
+        max_samples: Option<Bound<'py, PyAny>>,
+        channels: Option<Bound<'py, PyAny>>,
+        skip_separated: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Self> {
+        let given = given(
+            py,
+            [
+                ("integrator", integrator),
+                ("dt", dt),
+                ("rtol", rtol),
+                ("atol", atol),
+                ("rho_inf", rho_inf),
+                ("record_interval", record_interval),
+                ("max_samples", max_samples),
+                ("channels", channels),
+                ("skip_separated", skip_separated),
+            ],
+        )?;
+        apply(self.inner.clone(), Some(&given))
     }
-    if let Some(ch) = channels {
-        o.channels = ch
-            .iter()
-            .map(|c| Channel::parse(c))
-            .collect::<Result<_, _>>()?;
+
+    /// Integrator name.
+    #[getter]
+    fn integrator(&self) -> &'static str {
+        self.inner.method.name()
     }
-    o.skip_separated = skip_separated;
-    Ok(o)
+    /// Step [s] (initial step of an adaptive method); None = the integrator's default.
+    #[getter]
+    fn dt(&self) -> Option<f64> {
+        self.inner.dt
+    }
+    /// Relative velocity tolerance of the adaptive method.
+    #[getter]
+    fn rtol(&self) -> f64 {
+        self.inner.rtol
+    }
+    /// Displacement tolerance [m] (error control; Newton tolerance of generalized-alpha).
+    #[getter]
+    fn atol(&self) -> f64 {
+        self.inner.atol
+    }
+    /// Spectral radius at infinite frequency of generalized-alpha, in [0, 1].
+    #[getter]
+    fn rho_inf(&self) -> f64 {
+        self.inner.rho_inf
+    }
+    /// Sample interval [s]; None = 1e-4 s (coarsened to fit max_samples).
+    #[getter]
+    fn record_interval(&self) -> Option<f64> {
+        self.inner.record_interval
+    }
+    /// Most samples kept.
+    #[getter]
+    fn max_samples(&self) -> usize {
+        self.inner.max_samples
+    }
+    /// Channel groups recorded.
+    #[getter]
+    fn channels(&self) -> Vec<&'static str> {
+        self.inner.channels.iter().map(Channel::name).collect()
+    }
+    /// Whether pins that provably cannot touch skip the exact gap query.
+    #[getter]
+    fn skip_separated(&self) -> bool {
+        self.inner.skip_separated
+    }
+
+    /// The options as a dict (constructor names; `Options(**d)` rebuilds them).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("integrator", self.integrator())?;
+        d.set_item("dt", self.dt())?;
+        d.set_item("rtol", self.rtol())?;
+        d.set_item("atol", self.atol())?;
+        d.set_item("rho_inf", self.rho_inf())?;
+        d.set_item("record_interval", self.record_interval())?;
+        d.set_item("max_samples", self.max_samples())?;
+        d.set_item("channels", self.channels())?;
+        d.set_item("skip_separated", self.skip_separated())?;
+        Ok(d)
+    }
+
+    /// The options a run to `t_end` [s] actually uses: the step and sample interval resolved,
+    /// plus `t_end`.
+    fn resolved<'py>(&self, py: Python<'py>, t_end: f64) -> PyResult<Bound<'py, PyDict>> {
+        let o = self.for_run(t_end)?;
+        let d = self.to_dict(py)?;
+        d.set_item("t_end", t_end)?;
+        let s = o.settings();
+        let dt = if o.method.0.adaptive {
+            s.dt
+        } else {
+            crate::solve::integrator::FixedClock::new(t_end, s.dt).h
+        };
+        d.set_item("dt", dt)?;
+        d.set_item("record_interval", o.sample_interval())?;
+        Ok(d)
+    }
+
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>,))> {
+        let rebuild = py.import("rvdyn._core")?.getattr("options_from_dict")?;
+        Ok((rebuild, (self.to_dict(py)?,)))
+    }
+
+    fn __repr__(&self) -> String {
+        let o = &self.inner;
+        let opt = |v: Option<f64>| v.map_or("None".to_string(), |x| format!("{x:?}"));
+        format!(
+            "Options(integrator='{}', dt={}, rtol={:?}, atol={:?}, rho_inf={:?}, \
+             record_interval={}, max_samples={}, channels=[{}], skip_separated={})",
+            o.method.name(),
+            opt(o.dt),
+            o.rtol,
+            o.atol,
+            o.rho_inf,
+            opt(o.record_interval),
+            o.max_samples,
+            self.channels()
+                .iter()
+                .map(|c| format!("'{c}'"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            if o.skip_separated { "True" } else { "False" }
+        )
+    }
+}
+
+/// Rebuild options from `Options.to_dict()` (used by pickle).
+#[pyfunction]
+fn options_from_dict(d: &Bound<'_, PyDict>) -> PyResult<Options> {
+    apply(SimOptions::new(1.0, Method::GeneralizedAlpha), Some(d))
+}
+
+/// The registered integrators: (name, summary, default step [s], adaptive).
+#[pyfunction]
+fn integrators() -> Vec<(&'static str, &'static str, f64, bool)> {
+    INTEGRATORS
+        .iter()
+        .map(|e| (e.name, e.summary, e.default_dt, e.adaptive))
+        .collect()
+}
+
+/// The channel registry: per recorded array, a dict of name, group (the `channels` option
+/// that records it; None = always), shape of one sample (dimension names), unit, dtype, doc.
+#[pyfunction]
+fn channels<'py>(py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    CHANNELS
+        .iter()
+        .map(|c| {
+            let d = PyDict::new(py);
+            d.set_item("name", c.name)?;
+            d.set_item("group", c.group.map(|g| g.name()))?;
+            let shape: Vec<&str> = c.shape.iter().map(|x| x.name()).collect();
+            d.set_item("shape", pyo3::types::PyTuple::new(py, shape)?)?;
+            d.set_item("unit", c.unit)?;
+            d.set_item(
+                "dtype",
+                match c.dtype {
+                    Dtype::Float64 => "float64",
+                    Dtype::Int64 => "int64",
+                },
+            )?;
+            d.set_item("doc", c.doc)?;
+            Ok(d)
+        })
+        .collect()
 }
 
 /// Recorded series as numpy arrays (first axis = samples), plus the run statistics.
 fn to_python<'py>(
     py: Python<'py>,
     rec: Recording,
+    wall_time: f64,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
     let arrays = PyDict::new(py);
     let n = rec.samples;
     for (name, s) in rec.series {
         let mut shape = vec![n];
         shape.extend_from_slice(&s.sample_shape);
+        let int = CHANNELS
+            .iter()
+            .any(|c| c.name == name && c.dtype == Dtype::Int64);
         // The Vec moves into numpy without a copy; reshape returns a view of it.
-        let a = s.data.into_pyarray(py).reshape(shape)?;
-        arrays.set_item(name, a)?;
+        if int {
+            let counts: Vec<i64> = s.data.iter().map(|&v| v as i64).collect();
+            arrays.set_item(name, counts.into_pyarray(py).reshape(shape)?)?;
+        } else {
+            arrays.set_item(name, s.data.into_pyarray(py).reshape(shape)?)?;
+        }
     }
     let stats = PyDict::new(py);
-    for (k, v) in rec.stats {
+    for (k, v) in rec.stats.counts {
         stats.set_item(k, v)?;
     }
+    stats.set_item("dt", rec.stats.dt)?;
+    stats.set_item("wall_time", wall_time)?;
     Ok((arrays, stats))
 }
 
-/// Run one scene. The core runs on a worker thread with the GIL released; this thread wakes
-/// every 50 ms to let Python handle Ctrl-C (which stops the run cleanly) and to draw a
-/// progress bar on stderr when `progress` is true.
-#[pyfunction]
-#[pyo3(signature = (scene_json, t_end, integrator, dt=None, rtol=None, atol=None, rho_inf=None,
-    record_interval=None, max_samples=None, channels=None, progress=false, skip_separated=true))]
-#[allow(clippy::too_many_arguments)]
-fn simulate<'py>(
-    py: Python<'py>,
-    scene_json: &str,
-    t_end: f64,
-    integrator: &str,
-    dt: Option<f64>,
-    rtol: Option<f64>,
-    atol: Option<f64>,
-    rho_inf: Option<f64>,
-    record_interval: Option<f64>,
-    max_samples: Option<usize>,
-    channels: Option<Vec<String>>,
-    progress: bool,
-    skip_separated: bool,
-) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
-    let sc = scene(scene_json)?;
-    let opt = options(
-        t_end,
-        integrator,
-        dt,
-        rtol,
-        atol,
-        rho_inf,
-        record_interval,
-        max_samples,
-        channels,
-        skip_separated,
-    )?;
-    let control = RunControl::default();
+/// Run `work` on a worker thread with the GIL released. This thread wakes every 50 ms to let
+/// Python handle Ctrl-C (which asks the work to stop through `control` and raises
+/// `KeyboardInterrupt` once it has) and to draw a progress bar when `progress` gives the end
+/// time.
+fn run_detached<T: Send>(
+    py: Python<'_>,
+    control: &RunControl,
+    progress: Option<f64>,
+    work: impl FnOnce(&RunControl) -> T + Send,
+) -> PyResult<T> {
     let start = Instant::now();
-    let outcome = std::thread::scope(|s| -> PyResult<(Result<Recording, RvdynError>, f64)> {
-        // The worker reports through a channel, so this thread wakes the moment it is done
-        // (and every 50 ms meanwhile, for Ctrl-C and the progress bar).
+    std::thread::scope(|s| -> PyResult<T> {
+        // The worker reports through a channel, so this thread wakes the moment it is done.
         let (tx, rx) = std::sync::mpsc::channel();
         // A Mutex makes the receiver shareable with the GIL-free closure below.
         let rx = std::sync::Mutex::new(rx);
-        let (sc, opt, control) = (&sc, &opt, &control);
         let worker = s.spawn(move || {
-            let t0 = Instant::now();
-            let r = crate::dynamics::simulate(sc, opt, control);
-            let _ = tx.send((r, t0.elapsed().as_secs_f64()));
+            let _ = tx.send(work(control));
         });
         let mut last_draw = Instant::now();
         loop {
@@ -200,8 +395,8 @@ fn simulate<'py>(
             });
             match received {
                 Ok(done) => {
-                    if progress {
-                        draw_progress(opt.t_end, opt.t_end, start.elapsed().as_secs_f64());
+                    if let Some(t_end) = progress {
+                        draw_progress(t_end, t_end, start.elapsed().as_secs_f64());
                         eprintln!();
                     }
                     let _ = worker.join();
@@ -217,21 +412,40 @@ fn simulate<'py>(
             if let Err(e) = py.check_signals() {
                 control.request_stop();
                 let _ = worker.join();
-                if progress {
+                if progress.is_some() {
                     eprintln!();
                 }
                 return Err(e);
             }
-            if progress && last_draw.elapsed() > Duration::from_millis(250) {
-                draw_progress(control.time(), opt.t_end, start.elapsed().as_secs_f64());
+            if let Some(t_end) = progress
+                && last_draw.elapsed() > Duration::from_millis(250)
+            {
+                draw_progress(control.time(), t_end, start.elapsed().as_secs_f64());
                 last_draw = Instant::now();
             }
         }
+    })
+}
+
+/// Run one compiled scene to `t_end` [s]. Returns (arrays, statistics).
+#[pyfunction]
+#[pyo3(signature = (scene, t_end, options, progress = false))]
+fn simulate<'py>(
+    py: Python<'py>,
+    scene: &CompiledScene,
+    t_end: f64,
+    options: &Options,
+    progress: bool,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+    let opt = options.for_run(t_end)?;
+    let sc: Arc<Scene> = scene.scene.clone();
+    let control = RunControl::default();
+    let (result, core_time) = run_detached(py, &control, progress.then_some(t_end), |c| {
+        let t0 = Instant::now();
+        let r = crate::dynamics::simulate(&sc, &opt, c);
+        (r, t0.elapsed().as_secs_f64())
     })?;
-    let (result, core_time) = outcome;
-    let mut rec = result?;
-    rec.stats.insert("wall_time", core_time);
-    to_python(py, rec)
+    to_python(py, result?, core_time)
 }
 
 fn draw_progress(t: f64, t_end: f64, wall: f64) {
@@ -250,84 +464,66 @@ fn draw_progress(t: f64, t_end: f64, wall: f64) {
     let _ = err.flush();
 }
 
-/// Run many scenes in parallel (rayon, GIL released). Returns, per scene, either the
-/// recorded arrays and statistics or the exception its run raised.
+/// Run many compiled scenes in parallel (rayon, GIL released). Options are checked once
+/// (a bad option raises before any run); Ctrl-C stops every run within about 0.1 s and
+/// raises `KeyboardInterrupt`. Returns, per scene, (arrays, statistics) or the exception its
+/// run raised.
 #[pyfunction]
-#[pyo3(signature = (scene_jsons, t_end, integrator, dt=None, rtol=None, atol=None, rho_inf=None,
-    record_interval=None, max_samples=None, channels=None, threads=None, skip_separated=true))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (scenes, t_end, options, threads = None))]
 fn sweep<'py>(
     py: Python<'py>,
-    scene_jsons: Vec<String>,
+    scenes: Vec<PyRef<'py, CompiledScene>>,
     t_end: f64,
-    integrator: &str,
-    dt: Option<f64>,
-    rtol: Option<f64>,
-    atol: Option<f64>,
-    rho_inf: Option<f64>,
-    record_interval: Option<f64>,
-    max_samples: Option<usize>,
-    channels: Option<Vec<String>>,
+    options: &Options,
     threads: Option<usize>,
-    skip_separated: bool,
-) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let opt = options(
-        t_end,
-        integrator,
-        dt,
-        rtol,
-        atol,
-        rho_inf,
-        record_interval,
-        max_samples,
-        channels,
-        skip_separated,
-    )?;
-    let scenes: Vec<Scene> = scene_jsons
-        .iter()
-        .map(|j| scene(j))
-        .collect::<PyResult<_>>()?;
+) -> PyResult<Bound<'py, PyList>> {
+    let opt = options.for_run(t_end)?;
+    if threads.is_some_and(|n| n > MAX_THREADS) {
+        return Err(crate::python::parameter_error(format!(
+            "threads must be at most {MAX_THREADS} (None = one per core), got {threads:?}"
+        )));
+    }
+    let scenes: Vec<Arc<Scene>> = scenes.iter().map(|s| s.scene.clone()).collect();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
         .map_err(|e| {
             crate::python::parameter_error(format!("cannot start {threads:?} threads: {e}"))
         })?;
-    let results: Vec<(Result<Recording, RvdynError>, f64)> = py.detach(|| {
-        pool.install(|| {
-            scenes
-                .par_iter()
-                .map(|sc| {
-                    let start = Instant::now();
-                    let r = crate::dynamics::simulate(sc, &opt, &RunControl::default());
-                    (r, start.elapsed().as_secs_f64())
-                })
-                .collect()
-        })
-    });
-    results
-        .into_iter()
-        .map(|(r, wall)| match r {
-            Ok(mut rec) => {
-                rec.stats.insert("wall_time", wall);
-                let (a, s) = to_python(py, rec)?;
-                Ok((a, s).into_pyobject(py)?.into_any())
+    let control = RunControl::default();
+    let results: Vec<(Result<Recording, RvdynError>, f64)> =
+        run_detached(py, &control, None, |c| {
+            pool.install(|| {
+                scenes
+                    .par_iter()
+                    .map(|sc| {
+                        let start = Instant::now();
+                        let r = crate::dynamics::simulate(sc, &opt, c);
+                        (r, start.elapsed().as_secs_f64())
+                    })
+                    .collect()
+            })
+        })?;
+    let out = PyList::empty(py);
+    for (r, wall) in results {
+        match r {
+            Ok(rec) => out.append(to_python(py, rec, wall)?)?,
+            Err(RvdynError::Interrupted) => {
+                return Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
+                    "sweep interrupted",
+                ));
             }
-            Err(e) => Ok(super::errors::to_pyerr(py, e)
-                .into_value(py)
-                .into_bound(py)
-                .into_any()),
-        })
-        .collect()
+            Err(e) => out.append(super::errors::to_pyerr(py, e).into_value(py))?,
+        }
+    }
+    Ok(out)
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(scene_paper, m)?)?;
-    m.add_function(wrap_pyfunction!(scene_validate, m)?)?;
-    m.add_function(wrap_pyfunction!(scene_to_toml, m)?)?;
-    m.add_function(wrap_pyfunction!(scene_from_toml, m)?)?;
-    m.add_function(wrap_pyfunction!(scene_model_info, m)?)?;
-    m.add_function(wrap_pyfunction!(default_compliant_joints, m)?)?;
+    m.add_class::<Options>()?;
+    m.add_function(wrap_pyfunction!(options_from_dict, m)?)?;
+    m.add_function(wrap_pyfunction!(integrators, m)?)?;
+    m.add_function(wrap_pyfunction!(channels, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     Ok(())

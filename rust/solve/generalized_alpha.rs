@@ -10,8 +10,25 @@
 //! then split in halves (down to 1/1024 of the step) before the run is declared failed.
 
 use crate::error::{Result, RvdynError};
+use crate::solve::integrator::{FixedClock, Integrator, IntegratorEntry, Settings, Stats};
+use crate::solve::jacobian;
 use crate::solve::system::{MechanicalSystem, State};
 use nalgebra::{DMatrix, DVector};
+
+/// Registry entry of generalized-alpha.
+pub static ENTRY: IntegratorEntry = IntegratorEntry {
+    name: "generalized-alpha",
+    aliases: &["genalpha", "gen-alpha"],
+    default_dt: 1e-4,
+    adaptive: false,
+    summary: "generalized-alpha, implicit, order 2, fixed step, Newton with a reused Jacobian",
+    build: |s: &Settings| {
+        Ok(Box::new(GeneralizedAlphaRun {
+            stepper: GeneralizedAlpha::new(s.rho_inf, s.atol, s.track_work)?,
+            clock: FixedClock::new(s.t_end, s.dt),
+        }))
+    },
+};
 
 /// Generalized-alpha stepper with Jacobian reuse.
 #[derive(Debug)]
@@ -33,9 +50,13 @@ pub struct GeneralizedAlpha {
     theta: f64,
     /// Steps accepted after one iteration since theta was last measured.
     unmeasured: u32,
+    /// Jacobians computed (and factored).
     pub jacobians: u64,
+    /// Newton iterations, all steps.
     pub newton_iterations: u64,
+    /// Steps split in halves because Newton stalled.
     pub splits: u64,
+    /// Force evaluations, Jacobians included.
     pub evaluations: u64,
 }
 
@@ -72,11 +93,16 @@ impl GeneralizedAlpha {
     }
 
     /// Advance `st` by `h` [s] (in sub-steps if Newton needs them).
-    pub fn step<S: MechanicalSystem>(&mut self, sys: &S, st: &mut State, h: f64) -> Result<()> {
+    pub fn step<S: MechanicalSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        st: &mut State,
+        h: f64,
+    ) -> Result<()> {
         self.advance(sys, st, h, 0)
     }
 
-    fn advance<S: MechanicalSystem>(
+    fn advance<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
         st: &mut State,
@@ -103,7 +129,7 @@ impl GeneralizedAlpha {
     }
 
     /// One step of size `h`; `Ok(None)` if Newton does not converge (even with a fresh Jacobian).
-    fn try_step<S: MechanicalSystem>(
+    fn try_step<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
         st: &State,
@@ -120,7 +146,7 @@ impl GeneralizedAlpha {
         Ok(None)
     }
 
-    fn newton<S: MechanicalSystem>(
+    fn newton<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,
         st: &State,
@@ -220,39 +246,56 @@ impl GeneralizedAlpha {
         Ok(None)
     }
 
-    fn factor_jacobian<S: MechanicalSystem>(&mut self, sys: &S, st: &State, h: f64) -> Result<()> {
+    fn factor_jacobian<S: MechanicalSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        st: &State,
+        h: f64,
+    ) -> Result<()> {
         let n = st.q.len();
         let (am, af, b, g) = (self.am, self.af, self.beta, self.gamma);
-        let scale = sys.length_scale();
-        let mut f0 = vec![0.0; n];
-        let mut f1 = vec![0.0; n];
-        let mut p = [0.0; 3];
-        sys.eval(st.t, &st.q, &st.v, &mut f0, &mut p)?;
         let mut jac = DMatrix::<f64>::identity(n, n) * (1.0 - am);
-        let mut q = st.q.clone();
-        let mut v = st.v.clone();
-        for k in 0..n {
-            // Perturb by ~1 nm of displacement and ~1 um/s of velocity at the lever.
-            let dq = 1e-9 / scale[k].max(1e-12);
-            q[k] += dq;
-            sys.eval(st.t, &q, &v, &mut f1, &mut p)?;
-            q[k] = st.q[k];
+        // J = (1 - am) I - (1 - af) (b h^2 df/dq + g h df/dv), in this arithmetic order.
+        self.evaluations += jacobian::finite_difference(sys, st, |c| {
             for i in 0..n {
-                jac[(i, k)] -= (1.0 - af) * b * h * h * (f1[i] - f0[i]) / dq;
+                jac[(i, c.k)] -= (1.0 - af) * b * h * h * (c.f_dq[i] - c.f0[i]) / c.dq;
             }
-            let dv = 1e-6 / scale[k].max(1e-12);
-            v[k] += dv;
-            sys.eval(st.t, &q, &v, &mut f1, &mut p)?;
-            v[k] = st.v[k];
             for i in 0..n {
-                jac[(i, k)] -= (1.0 - af) * g * h * (f1[i] - f0[i]) / dv;
+                jac[(i, c.k)] -= (1.0 - af) * g * h * (c.f_dv[i] - c.f0[i]) / c.dv;
             }
-        }
-        self.evaluations += 1 + 2 * n as u64;
+        })?;
         self.jacobians += 1;
         self.lu = Some(jac.lu());
         self.lu_h = h;
         self.theta = 1.0;
         Ok(())
+    }
+}
+
+/// Generalized-alpha bound to one run: fixed steps to the end time.
+struct GeneralizedAlphaRun {
+    stepper: GeneralizedAlpha,
+    clock: FixedClock,
+}
+
+impl Integrator for GeneralizedAlphaRun {
+    fn advance(&mut self, sys: &dyn MechanicalSystem, st: &mut State, _t_end: f64) -> Result<()> {
+        self.stepper.step(sys, st, self.clock.h)?;
+        self.clock.tick(st);
+        Ok(())
+    }
+
+    fn stats(&self) -> Stats {
+        let g = &self.stepper;
+        Stats {
+            counts: vec![
+                ("steps", self.clock.taken),
+                ("evaluations", g.evaluations),
+                ("jacobians", g.jacobians),
+                ("newton_iterations", g.newton_iterations),
+                ("splits", g.splits),
+            ],
+            dt: Some(self.clock.h),
+        }
     }
 }

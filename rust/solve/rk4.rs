@@ -1,7 +1,24 @@
 //! Classical fixed-step fourth-order Runge-Kutta on `(q, v, work)`.
 
-use crate::error::Result;
+use crate::error::{Result, RvdynError};
+use crate::solve::integrator::{FixedClock, Integrator, IntegratorEntry, Settings, Stats};
+use crate::solve::stability;
 use crate::solve::system::{MechanicalSystem, State};
+
+/// Registry entry of RK4.
+pub static ENTRY: IntegratorEntry = IntegratorEntry {
+    name: "rk4",
+    aliases: &[],
+    default_dt: 1e-5,
+    adaptive: false,
+    summary: "classical Runge-Kutta, explicit, order 4, fixed step (stops at its stability limit)",
+    build: |s: &Settings| {
+        Ok(Box::new(Rk4Run {
+            stepper: Rk4::default(),
+            clock: FixedClock::new(s.t_end, s.dt),
+        }))
+    },
+};
 
 /// Reusable stage storage for RK4.
 #[derive(Debug, Default)]
@@ -16,7 +33,12 @@ pub struct Rk4 {
 impl Rk4 {
     /// Advance `st` by `h` [s].
     #[allow(clippy::needless_range_loop)]
-    pub fn step<S: MechanicalSystem>(&mut self, sys: &S, st: &mut State, h: f64) -> Result<()> {
+    pub fn step<S: MechanicalSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        st: &mut State,
+        h: f64,
+    ) -> Result<()> {
         let n = st.q.len();
         for k in 0..4 {
             self.kq[k].resize(n, 0.0);
@@ -55,4 +77,54 @@ impl Rk4 {
         sys.eval(st.t, &st.q, &st.v, &mut st.a, &mut st.power)?;
         Ok(())
     }
+}
+
+/// RK4 steps between two checks of its linearised stability (2 n force evaluations each).
+const STABILITY_CHECK: u64 = 250;
+
+/// RK4 bound to one run: fixed steps, with a check of the linearised stability limit every
+/// [`STABILITY_CHECK`] steps (an explicit method beyond it can return smooth-looking but wrong
+/// results).
+struct Rk4Run {
+    stepper: Rk4,
+    clock: FixedClock,
+}
+
+impl Integrator for Rk4Run {
+    fn advance(&mut self, sys: &dyn MechanicalSystem, st: &mut State, _t_end: f64) -> Result<()> {
+        if self.clock.taken.is_multiple_of(STABILITY_CHECK) {
+            check_stability(sys, st, self.clock.h)?;
+        }
+        self.stepper.step(sys, st, self.clock.h)?;
+        self.clock.tick(st);
+        Ok(())
+    }
+
+    fn stats(&self) -> Stats {
+        Stats {
+            counts: vec![
+                ("steps", self.clock.taken),
+                ("evaluations", 4 * self.clock.taken),
+            ],
+            dt: Some(self.clock.h),
+        }
+    }
+}
+
+/// Stop an RK4 run whose step is beyond the method's linearised stability limit at this state.
+fn check_stability(sys: &dyn MechanicalSystem, st: &State, h: f64) -> Result<()> {
+    let eigs = stability::linearised_eigenvalues(sys, st)?;
+    let growth = stability::rk4_excess_growth(&eigs, h);
+    if growth > 1.0 + 1e-6 {
+        let limit = stability::rk4_step_limit(&eigs, h);
+        return Err(RvdynError::Simulation(format!(
+            "rk4 with dt = {h:.3e} s is beyond its stability limit at t = {:.6e} s: a mode of the \
+             linearised reducer grows {growth:.3} times per step more than it should; the largest \
+             stable step here is about {limit:.3e} s: reduce dt below {:.2e} s or use \
+             integrator=\"generalized-alpha\"",
+            st.t,
+            0.8 * limit
+        )));
+    }
+    Ok(())
 }

@@ -3,42 +3,26 @@
 //! sign every step), so the driver checks the limit from time to time and stops with advice.
 
 use crate::error::Result;
-use crate::solve::{MechanicalSystem, State};
+use crate::solve::{MechanicalSystem, State, jacobian};
 use nalgebra::{Complex, DMatrix};
 
 /// Eigenvalues [1/s] of the linearised first-order system `d(q, v)/dt = (v, a(q, v))` at `st`,
 /// from a finite-difference Jacobian (2 n force evaluations).
-pub fn linearised_eigenvalues<S: MechanicalSystem>(
+pub fn linearised_eigenvalues<S: MechanicalSystem + ?Sized>(
     sys: &S,
     st: &State,
 ) -> Result<Vec<Complex<f64>>> {
     let n = st.q.len();
-    let scale = sys.length_scale();
-    let mut a0 = vec![0.0; n];
-    let mut a1 = vec![0.0; n];
-    let mut p = [0.0; 3];
-    sys.eval(st.t, &st.q, &st.v, &mut a0, &mut p)?;
     let mut m = DMatrix::<f64>::zeros(2 * n, 2 * n);
     for i in 0..n {
         m[(i, n + i)] = 1.0;
     }
-    let (mut q, mut v) = (st.q.clone(), st.v.clone());
-    for k in 0..n {
-        let dq = 1e-9 / scale[k].max(1e-12);
-        q[k] += dq;
-        sys.eval(st.t, &q, &v, &mut a1, &mut p)?;
-        q[k] = st.q[k];
+    jacobian::finite_difference(sys, st, |c| {
         for i in 0..n {
-            m[(n + i, k)] = (a1[i] - a0[i]) / dq;
+            m[(n + i, c.k)] = (c.f_dq[i] - c.f0[i]) / c.dq;
+            m[(n + i, n + c.k)] = (c.f_dv[i] - c.f0[i]) / c.dv;
         }
-        let dv = 1e-6 / scale[k].max(1e-12);
-        v[k] += dv;
-        sys.eval(st.t, &q, &v, &mut a1, &mut p)?;
-        v[k] = st.v[k];
-        for i in 0..n {
-            m[(n + i, n + k)] = (a1[i] - a0[i]) / dv;
-        }
-    }
+    })?;
     Ok(m.complex_eigenvalues().iter().copied().collect())
 }
 

@@ -18,8 +18,11 @@ pub trait MechanicalSystem {
 /// The integrated state: coordinates, velocities, accelerations and energy flows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
+    /// Time [s].
     pub t: f64,
+    /// Free coordinates.
     pub q: Vec<f64>,
+    /// Their velocities.
     pub v: Vec<f64>,
     /// Acceleration at `t` (for dense output and the generalized-alpha recursion).
     pub a: Vec<f64>,

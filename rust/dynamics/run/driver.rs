@@ -1,22 +1,25 @@
 //! The simulation driver: integrate a scene to `t_end`, recording at fixed sample times.
 
 use crate::dynamics::model::ReducerModel;
-use crate::dynamics::record::{Channel, Recorder, Recording};
-use crate::dynamics::rigid::RigidModel;
+use crate::dynamics::model::rigid::RigidModel;
+use crate::dynamics::model::rigid_system::RigidSystem;
+use crate::dynamics::run::recorder::{Channel, Recorder, Recording};
 use crate::dynamics::scene::{Joints, Scene};
-use crate::dynamics::system::RigidSystem;
 use crate::error::{Result, RvdynError};
-use crate::solve::dopri5::Dopri5;
-use crate::solve::generalized_alpha::GeneralizedAlpha;
-use crate::solve::rk4::Rk4;
-use crate::solve::{Method, State, stability};
+use crate::solve::{Integrator, Method, Settings, State};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+/// Most samples a run may keep (each sample holds up to a few hundred values of 8 bytes).
+pub const MAX_SAMPLES: usize = 100_000_000;
+/// Most steps a fixed-step run may take.
+pub const MAX_STEPS: f64 = 1e10;
 
 /// Options of one run (SI).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimOptions {
     /// End time [s].
     pub t_end: f64,
+    /// The integrator (a registry entry).
     pub method: Method,
     /// Step [s] of the fixed-step methods; initial step of the adaptive one. `None` = default.
     pub dt: Option<f64>,
@@ -31,6 +34,7 @@ pub struct SimOptions {
     pub record_interval: Option<f64>,
     /// Largest number of samples kept (memory bound: the interval is coarsened to fit).
     pub max_samples: usize,
+    /// Channel groups recorded.
     pub channels: Vec<Channel>,
     /// Skip the exact query of pins that provably cannot touch (exact: same answer).
     pub skip_separated: bool,
@@ -53,30 +57,76 @@ impl SimOptions {
         }
     }
 
-    /// The step used by a fixed-step method [s].
+    /// The step used by a fixed-step method [s] (the initial step of an adaptive one).
     pub fn default_dt(method: Method) -> f64 {
-        match method {
-            Method::Rk4 => 1e-5,
-            Method::Dopri5 => 1e-6,
-            Method::GeneralizedAlpha => 1e-4,
+        method.default_dt()
+    }
+
+    /// What the integrator is built from.
+    pub fn settings(&self) -> Settings {
+        let dt = self.dt.unwrap_or_else(|| self.method.default_dt());
+        Settings {
+            t_end: self.t_end,
+            dt,
+            rtol: self.rtol,
+            atol: self.atol,
+            rho_inf: self.rho_inf,
+            h_max: self.sample_interval().max(dt),
+            track_work: self.channels.contains(&Channel::Energy),
         }
     }
 
-    fn validate(&self) -> Result<()> {
-        let bad = |m: String| Err(RvdynError::Parameter(m));
+    /// Check every option; a `Parameter` error names the option and the rule.
+    pub fn validate(&self) -> Result<()> {
         if !(self.t_end.is_finite() && self.t_end > 0.0) {
-            return bad(format!(
+            return Err(RvdynError::Parameter(format!(
                 "t_end must be a finite time > 0 s, got {}",
                 self.t_end
-            ));
+            )));
         }
         if let Some(dt) = self.dt
-            && !(dt.is_finite() && dt > 0.0 && dt <= self.t_end)
+            && dt > self.t_end
+        {
+            return Err(RvdynError::Parameter(format!(
+                "dt must be > 0 s and <= t_end, got {dt}"
+            )));
+        }
+        self.validate_settings()?;
+        // A bound on the work: a fixed-step run of more than MAX_STEPS steps is a mistake
+        // (dt = 1e-300 would never end), not a request.
+        if !self.method.0.adaptive {
+            let dt = self.dt.unwrap_or_else(|| self.method.default_dt());
+            let steps = self.t_end / dt;
+            if steps > MAX_STEPS {
+                return Err(RvdynError::Parameter(format!(
+                    "dt = {dt:.3e} s over t_end = {:.3e} s would take {steps:.2e} steps, more \
+                     than {MAX_STEPS:.0e}: raise dt (the default of {} is {:.0e} s) or shorten \
+                     the run",
+                    self.t_end,
+                    self.method.name(),
+                    self.method.default_dt()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Check every option but the end time (what a reusable options object can check).
+    pub fn validate_settings(&self) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Parameter(m));
+        if let Some(dt) = self.dt
+            && !(dt.is_finite() && dt > 0.0)
         {
             return bad(format!("dt must be > 0 s and <= t_end, got {dt}"));
         }
         if !(self.rtol.is_finite() && self.rtol >= 0.0) {
             return bad(format!("rtol must be >= 0, got {}", self.rtol));
+        }
+        if !(0.0..=1.0).contains(&self.rho_inf) {
+            return bad(format!(
+                "rho_inf must be in [0, 1] (1 = no numerical damping), got {}",
+                self.rho_inf
+            ));
         }
         if !(self.atol.is_finite() && self.atol > 0.0) {
             return bad(format!("atol must be > 0 m, got {}", self.atol));
@@ -86,8 +136,11 @@ impl SimOptions {
         {
             return bad(format!("record_interval must be > 0 s, got {r}"));
         }
-        if self.max_samples < 2 {
-            return bad("max_samples must be at least 2".into());
+        if !(2..=MAX_SAMPLES).contains(&self.max_samples) {
+            return bad(format!(
+                "max_samples must be in 2..={MAX_SAMPLES:.0e} (memory: 8 bytes per value), got {}",
+                self.max_samples
+            ));
         }
         Ok(())
     }
@@ -123,27 +176,6 @@ impl RunControl {
     }
 }
 
-/// RK4 steps between two checks of its linearised stability (2 n force evaluations each).
-const RK4_STABILITY_CHECK: u64 = 250;
-
-/// Stop an RK4 run whose step is beyond the method's linearised stability limit at this state.
-fn check_rk4_stability<M: ReducerModel>(sys: &M, st: &State, h: f64) -> Result<()> {
-    let eigs = stability::linearised_eigenvalues(sys, st)?;
-    let growth = stability::rk4_excess_growth(&eigs, h);
-    if growth > 1.0 + 1e-6 {
-        let limit = stability::rk4_step_limit(&eigs, h);
-        return Err(RvdynError::Simulation(format!(
-            "rk4 with dt = {h:.3e} s is beyond its stability limit at t = {:.6e} s: a mode of the \
-             linearised reducer grows {growth:.3} times per step more than it should; the largest \
-             stable step here is about {limit:.3e} s: reduce dt below {:.2e} s or use \
-             integrator=\"generalized-alpha\"",
-            st.t,
-            0.8 * limit
-        )));
-    }
-    Ok(())
-}
-
 /// Simulate `scene` to `options.t_end` and return the recorded channels.
 ///
 /// Errors: `Scene`/`Parameter` for bad input, `Simulation` when the run goes unstable (with
@@ -157,31 +189,36 @@ pub fn simulate(scene: &Scene, options: &SimOptions, control: &RunControl) -> Re
             run(&RigidSystem::new(&model), options, control)
         }
         Joints::Compliant { .. } => {
-            let model = crate::dynamics::compliant::CompliantModel::new(scene)?;
+            let mut model = crate::dynamics::model::compliant::CompliantModel::new(scene)?;
+            model.skip_separated = options.skip_separated;
             run(&model, options, control)
         }
     }
 }
 
-/// Integrate a built model.
+/// Integrate a built model with the integrator named in the options.
 pub fn run<M: ReducerModel>(sys: &M, opt: &SimOptions, control: &RunControl) -> Result<Recording> {
+    opt.validate()?;
+    let integrator = opt.method.build(&opt.settings())?;
+    run_with(sys, opt, integrator, control)
+}
+
+/// Integrate a built model with a given integrator (any [`Integrator`], registered or not).
+pub fn run_with<M: ReducerModel>(
+    sys: &M,
+    opt: &SimOptions,
+    mut integrator: Box<dyn Integrator>,
+    control: &RunControl,
+) -> Result<Recording> {
     opt.validate()?;
     let (q0, v0) = sys.initial_state();
     let mut st = State::new(sys, 0.0, q0, v0)?;
     let interval = opt.sample_interval();
     let n_samples = (opt.t_end / interval + 1e-9).floor() as usize + 1;
     let mut rec = Recorder::new(sys.layout(), &opt.channels, n_samples);
-    let track_work = opt.channels.contains(&Channel::Energy);
     let mut next_sample = 0usize;
     let record =
         |rec: &mut Recorder, s: &State| -> Result<()> { rec.sample(sys, s.t, &s.q, &s.v, s.work) };
-    let dt = opt.dt.unwrap_or_else(|| SimOptions::default_dt(opt.method));
-    let mut rk4 = Rk4::default();
-    let mut dopri = Dopri5::new(opt.rtol, opt.atol, dt, interval.max(dt));
-    let mut galpha = GeneralizedAlpha::new(opt.rho_inf, opt.atol, track_work)?;
-    let n_fixed = (opt.t_end / dt).ceil().max(1.0) as u64;
-    let h_fixed = opt.t_end / n_fixed as f64;
-    let mut steps: u64 = 0;
     while next_sample < n_samples && next_sample as f64 * interval <= st.t + 1e-12 {
         record(&mut rec, &st)?;
         next_sample += 1;
@@ -191,20 +228,7 @@ pub fn run<M: ReducerModel>(sys: &M, opt: &SimOptions, control: &RunControl) -> 
             return Err(RvdynError::Interrupted);
         }
         let prev = st.clone();
-        match opt.method {
-            Method::Rk4 => {
-                if steps.is_multiple_of(RK4_STABILITY_CHECK) {
-                    check_rk4_stability(sys, &st, h_fixed)?;
-                }
-                rk4.step(sys, &mut st, h_fixed)?
-            }
-            Method::GeneralizedAlpha => galpha.step(sys, &mut st, h_fixed)?,
-            Method::Dopri5 => dopri.step(sys, &mut st, opt.t_end)?,
-        }
-        steps += 1;
-        if matches!(opt.method, Method::Rk4 | Method::GeneralizedAlpha) && steps == n_fixed {
-            st.t = opt.t_end;
-        }
+        integrator.advance(sys, &mut st, opt.t_end)?;
         if !st.q.iter().chain(&st.v).all(|v| v.is_finite()) {
             return Err(RvdynError::Simulation(format!(
                 "the state became non-finite at t = {:.6e} s; reduce the step or use the \
@@ -224,33 +248,6 @@ pub fn run<M: ReducerModel>(sys: &M, opt: &SimOptions, control: &RunControl) -> 
         control.set_time(st.t);
     }
     let mut out = rec.finish();
-    out.stats.insert("steps", steps as f64);
-    match opt.method {
-        Method::Rk4 => {
-            out.stats.insert("evaluations", 4.0 * steps as f64);
-        }
-        Method::Dopri5 => {
-            out.stats.insert("rejected", dopri.rejected as f64);
-            out.stats.insert(
-                "evaluations",
-                6.0 * (dopri.accepted + dopri.rejected) as f64,
-            );
-        }
-        Method::GeneralizedAlpha => {
-            out.stats.insert("evaluations", galpha.evaluations as f64);
-            out.stats.insert("jacobians", galpha.jacobians as f64);
-            out.stats
-                .insert("newton_iterations", galpha.newton_iterations as f64);
-            out.stats.insert("splits", galpha.splits as f64);
-        }
-    }
-    out.stats.insert(
-        "dt",
-        if opt.method == Method::Dopri5 {
-            f64::NAN
-        } else {
-            h_fixed
-        },
-    );
+    out.stats = integrator.stats();
     Ok(out)
 }

@@ -1,4 +1,4 @@
-//! Rigid-joint model in reduced coordinates (design.md section 5).
+//! Rigid-joint model in reduced coordinates (docs/model.md#coordinates-and-degrees-of-freedom).
 //!
 //! Coordinates `x = [th_c, alpha, th_s]`: carrier angle, absolute crank angle (all cranks equal
 //! when the joints are ideal), sun angle. Disc `k` (eccentric phase `a_k`) has its centre at
@@ -12,15 +12,13 @@
 //! `Q = -F grad(delta)`. Prescribed coordinates are taken from the drive; the reaction
 //! `M_ii a_i - Q_i` on them is the input torque.
 
-use crate::contact::ImpactLaw;
-use crate::dynamics::drive::DriveProfile;
-use crate::dynamics::model::Layout;
-use crate::dynamics::pin_contact::{DiscPose, WarmStart, penetration_error, pin_query};
-use crate::dynamics::scene::{Initial, Joints, Load, Scene};
-use crate::dynamics::sink::ContactSink;
+pub(crate) use crate::dynamics::model::parts::Parts;
+use crate::dynamics::model::pin_contact::{
+    DiscPose, SeparationBound, WarmStart, penetration_error, pin_query,
+};
+use crate::dynamics::run::sink::ContactSink;
+use crate::dynamics::scene::{Initial, Joints, Scene};
 use crate::error::{Result, RvdynError};
-use crate::geometry::CycloidGeometry;
-use crate::geometry::mass::{DiscHoles, MassProperties, disc_mass_properties, solid_cylinder};
 use std::cell::Cell;
 
 /// Index of the carrier angle in the full coordinate vector.
@@ -30,102 +28,44 @@ pub const CRANK: usize = 1;
 /// Index of the sun angle.
 pub const SUN: usize = 2;
 
-/// One disc of the model.
-#[derive(Debug, Clone)]
-pub struct DiscModel {
-    pub geometry: CycloidGeometry,
-    /// Eccentric phase on the crank [rad].
-    pub phase: f64,
-    /// Disc angle offset from the carrier angle, `-phase / zc` [rad].
-    pub angle_offset: f64,
-}
-
-/// One fixed pin.
-#[derive(Debug, Clone, Copy)]
-pub struct PinModel {
-    pub centre: [f64; 2],
-    pub radius: f64,
-    /// Nominal angle of the pin on the pin circle [rad] (the kinematic seed of its contact).
-    pub angle: f64,
-}
-
-/// The sun/planet meshes of the first stage.
-#[derive(Debug, Clone, Copy)]
-pub struct MeshModel {
-    pub sun_base_radius: f64,
-    pub planet_base_radius: f64,
-    /// Total backlash along the line of action [m].
-    pub backlash: f64,
-    pub law: ImpactLaw,
-    pub count: usize,
-}
-
-/// Mass properties actually used by a model (computed or from the scene).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ModelInertias {
-    pub sun: MassProperties,
-    pub crank: MassProperties,
-    pub disc: MassProperties,
-    pub carrier: MassProperties,
-    pub load_inertia: f64,
-}
-
 /// Generalised forces and power flows from one evaluation.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct Forces {
+pub(crate) struct Forces {
     /// Generalised forces on `[th_c, alpha, th_s]` [N m].
-    pub q: [f64; 3],
+    pub(crate) q: [f64; 3],
     /// Power dissipated by contact damping [W].
-    pub dissipation: f64,
+    pub(crate) dissipation: f64,
     /// Elastic energy stored in the contacts [J] (only when asked for).
-    pub potential: f64,
+    pub(crate) potential: f64,
 }
 
-/// The rigid-joint reducer model.
+/// The rigid-joint reducer model: the shared [`Parts`] plus its coordinates.
 #[derive(Debug, Clone)]
 pub struct RigidModel {
-    pub discs: Vec<DiscModel>,
-    pub pins: Vec<PinModel>,
-    pub pin_law: ImpactLaw,
-    pub mesh: Option<MeshModel>,
-    pub cranks: usize,
-    pub crank_radius: f64,
-    pub eccentricity: f64,
-    pub inertias: ModelInertias,
+    /// Geometry, laws, inertias, drive and load (shared with the compliant model).
+    pub(crate) parts: Parts,
     /// Diagonal generalised mass of `[th_c, alpha, th_s]`.
-    pub mass: [f64; 3],
+    pub(crate) mass: [f64; 3],
     /// Free coordinates (indices into the full vector).
-    pub free: Vec<usize>,
+    pub(crate) free: Vec<usize>,
     /// The prescribed coordinate, if the drive is a speed.
-    pub prescribed: Option<usize>,
+    pub(crate) prescribed: Option<usize>,
     /// The coordinate the drive acts on (sun, or crank without a first stage).
-    pub input: usize,
-    pub drive: DriveProfile,
-    pub load: Load,
-    pub ratio: f64,
-    pub initial: Initial,
+    pub(crate) input: usize,
     /// Lever length per full coordinate [m per rad], turning angle errors into displacements.
-    pub length_scale: [f64; 3],
-    /// Penetration beyond which a run is declared unstable [m].
-    pub max_penetration: f64,
+    pub(crate) length_scale: [f64; 3],
     /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start).
-    pub warm_seeds: Vec<Cell<WarmStart>>,
+    pub(crate) warm_seeds: Vec<Cell<WarmStart>>,
     /// Skip the exact query of a pin that provably cannot touch (see [`SeparationBound`]).
-    pub skip_separated: bool,
+    pub(crate) skip_separated: bool,
     separation: Vec<Cell<SeparationBound>>,
-    /// Largest distance of a profile point from its disc centre [m].
-    profile_reach: f64,
 }
 
-/// The last exact gap of one (disc, pin) pair and the disc pose it was computed at. Moving a
-/// disc by `dO` and turning it by `dth` moves every profile point by at most
-/// `|dO| + reach |dth|`, and the gap by no more: while `gap - that > 0` the pin cannot touch and
-/// its exact query is skipped. The answer is the same as without skipping (tested).
-#[derive(Debug, Clone, Copy)]
-struct SeparationBound {
-    centre: [f64; 2],
-    angle: f64,
-    gap: f64,
+impl std::ops::Deref for RigidModel {
+    type Target = Parts;
+    fn deref(&self) -> &Parts {
+        &self.parts
+    }
 }
 
 impl RigidModel {
@@ -139,53 +79,13 @@ impl RigidModel {
                     .into(),
             ));
         }
+        let parts = Parts::new(scene)?;
         let cyc = scene.cycloid;
         let zp = cyc.pins as usize;
-        let zc = (cyc.pins - 1) as f64;
-        let mut discs = Vec::with_capacity(scene.discs.len());
-        for (k, d) in scene.discs.iter().enumerate() {
-            discs.push(DiscModel {
-                geometry: CycloidGeometry::new(scene.disc_params(k))?,
-                phase: d.phase,
-                angle_offset: -d.phase / zc,
-            });
-        }
-        let pins = (0..zp)
-            .map(|j| {
-                let th = std::f64::consts::TAU * j as f64 / zp as f64;
-                let dp = scene
-                    .pin_errors
-                    .position
-                    .get(j)
-                    .copied()
-                    .unwrap_or([0.0, 0.0]);
-                let dr = scene.pin_errors.radius.get(j).copied().unwrap_or(0.0);
-                PinModel {
-                    centre: [
-                        cyc.pin_circle_radius * th.cos() + dp[0],
-                        cyc.pin_circle_radius * th.sin() + dp[1],
-                    ],
-                    radius: cyc.pin_radius + dr,
-                    angle: th,
-                }
-            })
-            .collect();
-        let pin_law = scene.contact.pin.law(cyc.face_width)?;
-        let mesh = match &scene.stage1 {
-            Some(s) => Some(MeshModel {
-                sun_base_radius: s.sun_base_radius(),
-                planet_base_radius: s.planet_base_radius(),
-                backlash: s.backlash,
-                law: scene.contact.mesh.law(s.face_width)?,
-                count: s.planets as usize,
-            }),
-            None => None,
-        };
-        let crank_radius = scene.stage1.as_ref().map_or(0.09, |s| s.centre_distance());
-        let inertias = default_inertias(scene, &discs[0].geometry, crank_radius)?;
+        let (inertias, mesh, crank_radius) = (parts.inertias, parts.mesh, parts.crank_radius);
         let n_cr = f64::from(scene.cranks);
         let e = cyc.eccentricity;
-        let nd = discs.len() as f64;
+        let nd = parts.discs.len() as f64;
         let mass = [
             inertias.carrier.inertia
                 + inertias.load_inertia
@@ -195,8 +95,7 @@ impl RigidModel {
             inertias.sun.inertia,
         ];
         let input = if mesh.is_some() { SUN } else { CRANK };
-        let drive = DriveProfile::new(&scene.drive);
-        let (free, prescribed) = match (drive.is_speed(), mesh.is_some()) {
+        let (free, prescribed) = match (parts.drive.is_speed(), mesh.is_some()) {
             (true, true) => (vec![CARRIER, CRANK], Some(SUN)),
             (false, true) => (vec![CARRIER, CRANK, SUN], None),
             (true, false) => (vec![CARRIER], Some(CRANK)),
@@ -205,47 +104,20 @@ impl RigidModel {
         let rp = cyc.pin_circle_radius;
         let length_scale = [rp, e, mesh.map_or(0.0, |m| m.sun_base_radius)];
         Ok(Self {
-            discs,
-            pins,
-            pin_law,
-            mesh,
-            cranks: scene.cranks as usize,
-            crank_radius,
-            eccentricity: e,
-            inertias,
+            parts,
             mass,
             free,
             prescribed,
             input,
-            drive,
-            load: scene.load.clone(),
-            ratio: scene.ratio(),
-            initial: scene.initial,
             length_scale,
-            // A tenth of the pin radius is far beyond any elastic approach of steel.
-            max_penetration: 0.1 * cyc.pin_radius,
             warm_seeds: vec![Cell::new(WarmStart::default()); scene.discs.len() * zp],
             skip_separated: true,
-            separation: vec![
-                Cell::new(SeparationBound {
-                    centre: [0.0; 2],
-                    angle: 0.0,
-                    gap: f64::NEG_INFINITY
-                });
-                scene.discs.len() * zp
-            ],
-            profile_reach: (0..scene.discs.len())
-                .map(|k| {
-                    let p = scene.disc_params(k);
-                    p.pin_circle_radius + p.d_rp + p.eccentricity - p.pin_radius - p.d_rrp
-                })
-                .fold(0.0, f64::max)
-                * 1.000_001,
+            separation: vec![Cell::new(SeparationBound::default()); scene.discs.len() * zp],
         })
     }
 
     /// Initial full state `(x, v)` at t = 0: kinematic pose, at rest or at kinematic speed.
-    pub fn initial_state(&self) -> ([f64; 3], [f64; 3]) {
+    pub(crate) fn initial_state(&self) -> ([f64; 3], [f64; 3]) {
         let x = [0.0, 0.0, 0.0];
         let mut v = [0.0; 3];
         if self.initial == Initial::Steady {
@@ -268,25 +140,10 @@ impl RigidModel {
         (x, v)
     }
 
-    /// Sizes of the bodies and contacts (the shapes of recorded arrays).
-    pub fn layout(&self) -> Layout {
-        Layout {
-            discs: self.discs.len(),
-            pins: self.pins.len(),
-            cranks: self.cranks,
-            meshes: self.mesh.map_or(0, |m| m.count),
-        }
-    }
-
-    /// Number of lobes `zc`.
-    pub fn zc(&self) -> f64 {
-        f64::from(self.discs[0].geometry.lobes())
-    }
-
     /// Overwrite the prescribed coordinate of a full state with the drive at time `t`;
     /// returns its acceleration.
     #[inline]
-    pub fn apply_drive(&self, t: f64, x: &mut [f64; 3], v: &mut [f64; 3]) -> f64 {
+    pub(crate) fn apply_drive(&self, t: f64, x: &mut [f64; 3], v: &mut [f64; 3]) -> f64 {
         match self.prescribed {
             Some(p) => {
                 let (ang, spd, acc) = self.drive.motion(t);
@@ -300,7 +157,7 @@ impl RigidModel {
 
     /// Disc `k` centre [m] and angle [rad] for the full coordinates `x`.
     #[inline]
-    pub fn disc_pose(&self, k: usize, x: &[f64; 3]) -> ([f64; 2], f64) {
+    pub(crate) fn disc_pose(&self, k: usize, x: &[f64; 3]) -> ([f64; 2], f64) {
         let d = &self.discs[k];
         let (s, c) = (x[CRANK] + d.phase).sin_cos();
         (
@@ -313,7 +170,7 @@ impl RigidModel {
     ///
     /// Fails with `SimulationError` if a state is not finite or a penetration exceeds the
     /// physical bound or an exact gap cannot be found (the disc is far from any sensible pose).
-    pub fn forces<S: ContactSink>(
+    pub(crate) fn forces<S: ContactSink>(
         &self,
         t: f64,
         x: &[f64; 3],
@@ -330,15 +187,13 @@ impl RigidModel {
             let pose = DiscPose::new(o, th);
             for (j, pin) in self.pins.iter().enumerate() {
                 let idx = k * self.pins.len() + j;
-                if self.skip_separated {
-                    let b = self.separation[idx].get();
-                    let (dx, dy) = (o[0] - b.centre[0], o[1] - b.centre[1]);
-                    let moved =
-                        (dx * dx + dy * dy).sqrt() + self.profile_reach * (th - b.angle).abs();
-                    if b.gap > moved {
-                        sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
-                        continue;
-                    }
+                if self.skip_separated
+                    && self.separation[idx]
+                        .get()
+                        .separated(o, th, self.profile_reach)
+                {
+                    sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
+                    continue;
                 }
                 let pc = pin_query(d, pin, &pose, t, (k, j), &self.warm_seeds[idx])?;
                 if self.skip_separated {
@@ -379,16 +234,7 @@ impl RigidModel {
             let delta = m.sun_base_radius * (x[SUN] - x[CARRIER])
                 + m.planet_base_radius * (x[CRANK] - x[CARRIER]);
             let rate = m.sun_base_radius * (v[SUN] - vc) + m.planet_base_radius * (va - vc);
-            let half = 0.5 * m.backlash;
-            let (f, elastic, pen, pen_rate) = if delta > half {
-                let p = delta - half;
-                (m.law.force(p, rate), m.law.elastic_force(p), p, rate)
-            } else if delta < -half {
-                let p = -delta - half;
-                (-m.law.force(p, -rate), -m.law.elastic_force(p), p, -rate)
-            } else {
-                (0.0, 0.0, 0.0, 0.0)
-            };
+            let (f, elastic, pen, pen_rate) = m.law.mesh(m.backlash, delta, rate);
             if pen > 0.0 {
                 if check && (pen.is_nan() || pen >= self.max_penetration) {
                     return Err(penetration_error(
@@ -425,7 +271,7 @@ impl RigidModel {
     }
 
     /// Kinetic energy of the free bodies [J] (the prescribed input is a driver, not counted).
-    pub fn kinetic_energy(&self, v: &[f64; 3]) -> f64 {
+    pub(crate) fn kinetic_energy(&self, v: &[f64; 3]) -> f64 {
         (0..3)
             .filter(|i| Some(*i) != self.prescribed && (*i != SUN || self.mesh.is_some()))
             .map(|i| 0.5 * self.mass[i] * v[i] * v[i])
@@ -433,62 +279,11 @@ impl RigidModel {
     }
 }
 
-/// Mass properties from the scene or from simple steel solids (stated in each line).
-fn default_inertias(
-    scene: &Scene,
-    disc: &CycloidGeometry,
-    crank_radius: f64,
-) -> Result<ModelInertias> {
-    let rho = scene.density;
-    let i = &scene.inertias;
-    let (sun_r, planet_r, gear_w) = scene.stage1.as_ref().map_or((0.027, 0.063, 0.03), |s| {
-        (s.sun_pitch_radius(), s.planet_pitch_radius(), s.face_width)
-    });
-    // Sun: gear cylinder at its pitch radius, plus a 20 mm radius, 150 mm input shaft.
-    let sun = i.sun.unwrap_or_else(|| {
-        add(
-            solid_cylinder(sun_r, gear_w, rho),
-            solid_cylinder(0.020, 0.150, rho),
-        )
-    });
-    // Crank: planet gear cylinder at its pitch radius, plus a 25 mm radius, 150 mm crankshaft.
-    let crank = i.crank.unwrap_or_else(|| {
-        add(
-            solid_cylinder(planet_r, gear_w, rho),
-            solid_cylinder(0.025, 0.150, rho),
-        )
-    });
-    let disc_mp = match i.disc {
-        Some(d) => d,
-        None => disc_mass_properties(disc, &DiscHoles::paper(), rho)?,
-    };
-    // Carrier: two end plates of radius rp - rrp - 10 mm, 30 mm thick.
-    let plate_r = scene.cycloid.pin_circle_radius - scene.cycloid.pin_radius - 0.010;
-    let carrier = i.carrier.unwrap_or_else(|| {
-        let p = solid_cylinder(plate_r.max(crank_radius), 0.030, rho);
-        add(p, p)
-    });
-    Ok(ModelInertias {
-        sun,
-        crank,
-        disc: disc_mp,
-        carrier,
-        load_inertia: i.load_inertia,
-    })
-}
-
-fn add(a: MassProperties, b: MassProperties) -> MassProperties {
-    MassProperties {
-        mass: a.mass + b.mass,
-        inertia: a.inertia + b.inertia,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dynamics::sink::NoSink;
-    use crate::dynamics::system::RigidSystem;
+    use crate::dynamics::model::rigid_system::RigidSystem;
+    use crate::dynamics::run::sink::NoSink;
     use crate::solve::State;
     use crate::solve::generalized_alpha::GeneralizedAlpha;
 

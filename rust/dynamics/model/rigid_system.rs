@@ -1,18 +1,19 @@
 //! The rigid-joint model seen by the integrators: free coordinates only.
 
+use crate::dynamics::model::rigid::{CARRIER, CRANK, Forces, RigidModel, SUN};
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
-use crate::dynamics::rigid::{CARRIER, CRANK, Forces, RigidModel, SUN};
-use crate::dynamics::sink::{ContactSink, DynSink, NoSink};
+use crate::dynamics::run::sink::{ContactSink, DynSink, NoSink};
 use crate::error::Result;
 use crate::solve::MechanicalSystem;
 
 /// Adapter from [`RigidModel`] (full coordinates) to a [`MechanicalSystem`] in the free ones.
 pub struct RigidSystem<'a> {
-    pub model: &'a RigidModel,
+    pub(crate) model: &'a RigidModel,
     scale: Vec<f64>,
 }
 
 impl<'a> RigidSystem<'a> {
+    /// The adapter of a built model.
     pub fn new(model: &'a RigidModel) -> Self {
         let scale = model.free.iter().map(|&i| model.length_scale[i]).collect();
         Self { model, scale }
@@ -21,7 +22,7 @@ impl<'a> RigidSystem<'a> {
     /// Full coordinates from free ones at time `t` (prescribed ones from the drive); returns
     /// the prescribed acceleration.
     #[inline]
-    pub fn full(&self, t: f64, q: &[f64], v: &[f64]) -> ([f64; 3], [f64; 3], f64) {
+    pub(crate) fn full(&self, t: f64, q: &[f64], v: &[f64]) -> ([f64; 3], [f64; 3], f64) {
         let mut x = [0.0; 3];
         let mut xv = [0.0; 3];
         for (k, &i) in self.model.free.iter().enumerate() {
@@ -68,6 +69,23 @@ impl MechanicalSystem for RigidSystem<'_> {
 }
 
 impl ReducerModel for RigidSystem<'_> {
+    fn free_mass(&self) -> Vec<f64> {
+        self.model
+            .free
+            .iter()
+            .map(|&i| self.model.mass[i])
+            .collect()
+    }
+
+    fn generalized_force(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
+        let (x, xv, _) = self.full(t, q, v);
+        let f = self.model.forces(t, &x, &xv, &mut NoSink)?;
+        for (k, &i) in self.model.free.iter().enumerate() {
+            out[k] = f.q[i];
+        }
+        Ok(())
+    }
+
     fn layout(&self) -> Layout {
         self.model.layout()
     }

@@ -1,14 +1,22 @@
 //! A reducer scene: everything a dynamic run needs, serialisable to JSON and TOML.
 //!
 //! Every field is SI. Optional fields (`None`) are computed from the geometry when the model is
-//! built. [`Scene::paper`] is the default scene of design.md section 7.
+//! built. [`Scene::paper`] is the default scene of docs/model.md#default-scene.
+
+mod paths;
+mod presets;
+pub mod schema;
+mod validate;
+
+pub use paths::get_path;
+pub(crate) use paths::{set_path, unknown_fields};
+pub use presets::{PAPER_INPUT_SPEED, PAPER_POWER, PAPER_PRINTED_LOAD};
 
 use crate::contact::ImpactLaw;
 use crate::error::{Result, RvdynError};
 use crate::geometry::cycloid::CycloidParams;
 use crate::geometry::involute::InvoluteStage;
 use crate::geometry::mass::MassProperties;
-use crate::kinematics::operating_point;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -21,8 +29,10 @@ pub struct DiscSpec {
     /// Profile modifications of this disc [m, m, rad]; overrides the scene's `cycloid` values.
     #[serde(default)]
     pub d_rp: Option<f64>,
+    /// Equidistant modification of this disc [m] (`None` = the scene's).
     #[serde(default)]
     pub d_rrp: Option<f64>,
+    /// Rotation modification of this disc [rad] (`None` = the scene's).
     #[serde(default)]
     pub d_delta: Option<f64>,
 }
@@ -102,6 +112,7 @@ pub enum ContactLawSpec {
     Impact {
         /// k [N/m^exponent].
         stiffness: f64,
+        /// Force exponent e.
         exponent: f64,
         /// cmax [N s/m].
         max_damping: f64,
@@ -179,7 +190,9 @@ pub enum StartKind {
 pub enum Drive {
     /// Prescribed input speed [rad/s].
     Speed {
+        /// Input speed [rad/s].
         speed: f64,
+        /// How the speed starts.
         start: StartKind,
         /// Ramp duration [s] (for `start = "ramp"`).
         #[serde(default)]
@@ -187,7 +200,9 @@ pub enum Drive {
     },
     /// Prescribed input torque [N m] (the input becomes a degree of freedom).
     Torque {
+        /// Input torque [N m].
         torque: f64,
+        /// Ramp duration [s] (0 = full torque from t = 0).
         #[serde(default)]
         ramp_time: f64,
     },
@@ -200,11 +215,24 @@ pub enum Load {
     /// No load.
     Idle,
     /// Constant torque [N m] from t = 0.
-    Constant { torque: f64 },
+    Constant {
+        /// Torque [N m].
+        torque: f64,
+    },
     /// `before` [N m] until `time` [s], then `after`.
-    Step { before: f64, after: f64, time: f64 },
+    Step {
+        /// Torque before the step [N m].
+        before: f64,
+        /// Torque after the step [N m].
+        after: f64,
+        /// Time of the step [s].
+        time: f64,
+    },
     /// Piecewise-linear table of (t [s], torque [N m]), held constant outside.
-    Table { points: Vec<[f64; 2]> },
+    Table {
+        /// (t [s], torque [N m]) pairs, times strictly increasing.
+        points: Vec<[f64; 2]>,
+    },
 }
 
 impl Load {
@@ -279,88 +307,46 @@ pub struct Scene {
     pub pin_errors: PinErrors,
     /// Material density for computed inertias [kg/m^3].
     pub density: f64,
+    /// Mass properties (`None` entries computed from the geometry).
     #[serde(default)]
     pub inertias: Inertias,
+    /// Rigid or compliant joints.
     pub joints: Joints,
+    /// Contact laws of the pins and meshes.
     pub contact: ContactLaws,
+    /// The input drive.
     pub drive: Drive,
+    /// The load on the output.
     pub load: Load,
+    /// Initial state.
     pub initial: Initial,
 }
 
-/// The paper's input speed, 8328 deg/s [rad/s].
-pub const PAPER_INPUT_SPEED: f64 = 8328.0 * PI / 180.0;
-/// The paper's power, 112 kW [W].
-pub const PAPER_POWER: f64 = 112e3;
-/// The paper's printed output torque [N m] (inconsistent with 112 kW: erratum 3).
-pub const PAPER_PRINTED_LOAD: f64 = 4024.9;
-
 impl Scene {
-    /// The default scene of design.md section 7 with the chosen load case: `"idle"`,
-    /// `"paper"` (the printed 4024.9 N m) or `"rated"` (43.9 kN m = 57 x 770.6 N m, lossless
-    /// 112 kW at 8328 deg/s).
-    pub fn paper(load: &str) -> Result<Self> {
-        let load = match load {
-            "idle" => Load::Idle,
-            "paper" => Load::Constant {
-                torque: PAPER_PRINTED_LOAD,
-            },
-            "rated" => {
-                let op = operating_point(PAPER_POWER, PAPER_INPUT_SPEED, 57.0)?;
-                Load::Constant {
-                    torque: op.output_torque,
-                }
-            }
-            other => {
-                return Err(RvdynError::Scene(format!(
-                    "unknown load case {other:?}: choose \"idle\", \"paper\" (4024.9 N m as \
-                     printed) or \"rated\" (43.9 kN m, consistent with 112 kW)"
-                )));
-            }
-        };
-        Ok(Scene {
-            name: "paper".into(),
-            stage1: Some(paper_stage1()?),
-            cycloid: CycloidParams::paper(),
-            discs: vec![
-                DiscSpec {
-                    phase: 0.0,
-                    d_rp: None,
-                    d_rrp: None,
-                    d_delta: None,
-                },
-                DiscSpec {
-                    phase: PI,
-                    d_rp: None,
-                    d_rrp: None,
-                    d_delta: None,
-                },
-            ],
-            cranks: 3,
-            pin_errors: PinErrors::default(),
-            density: crate::geometry::mass::STEEL_DENSITY,
-            inertias: Inertias::default(),
-            joints: Joints::Rigid,
-            contact: ContactLaws {
-                pin: ContactLawSpec::paper(),
-                mesh: ContactLawSpec::paper(),
-            },
-            drive: Drive::Speed {
-                speed: PAPER_INPUT_SPEED,
-                start: StartKind::Step,
-                ramp_time: 0.0,
-            },
-            load,
-            initial: Initial::Rest,
-        })
-    }
-
     /// Parse a scene from JSON text.
     pub fn from_json(text: &str) -> Result<Self> {
-        let s: Scene = serde_json::from_str(text)
-            .map_err(|e| RvdynError::Scene(format!("invalid scene JSON: {e}")))?;
+        let v: serde_json::Value = serde_json::from_str(text)
+            .map_err(|e| RvdynError::Scene(format!("scene text is not valid JSON: {e}")))?;
+        Self::from_value(&v)
+    }
+
+    /// Build and validate a scene from a JSON tree. Every key of the tree must be a field of
+    /// the schema: an unknown one (a typo, or a field of another `kind`) is a `Scene` error
+    /// naming its path, in internally tagged enums too (where serde's `deny_unknown_fields`
+    /// does not reach).
+    pub fn from_value(v: &serde_json::Value) -> Result<Self> {
+        let s: Scene = serde_json::from_value(v.clone())
+            .map_err(|e| RvdynError::Scene(format!("invalid scene: {e}")))?;
+        let normal = s.to_value()?;
+        unknown_fields(v, &normal, "")?;
         s.validate()?;
         Ok(s)
+    }
+
+    /// The scene as a JSON tree (every field present, `null` for an absent optional one).
+    pub fn to_value(&self) -> Result<serde_json::Value> {
+        serde_json::to_value(self)
+            .map_err(|e| RvdynError::Scene(format!("scene cannot be written as JSON: {e}")))
     }
 
     /// Serialise to pretty JSON.
@@ -371,10 +357,9 @@ impl Scene {
 
     /// Parse a scene from TOML text.
     pub fn from_toml(text: &str) -> Result<Self> {
-        let s: Scene = toml::from_str(text)
-            .map_err(|e| RvdynError::Scene(format!("invalid scene TOML: {e}")))?;
-        s.validate()?;
-        Ok(s)
+        let v: serde_json::Value = toml::from_str(text)
+            .map_err(|e| RvdynError::Scene(format!("scene text is not valid TOML: {e}")))?;
+        Self::from_value(&v)
     }
 
     /// Serialise to TOML.
@@ -383,176 +368,14 @@ impl Scene {
             .map_err(|e| RvdynError::Scene(format!("scene cannot be written as TOML: {e}")))
     }
 
-    /// Check the scene as a whole; errors say which field is wrong and how to fix it.
-    pub fn validate(&self) -> Result<()> {
-        let err = |m: String| Err(RvdynError::Scene(m));
-        if self.discs.is_empty() || self.discs.len() > 2 {
-            return err(format!(
-                "a scene needs 1 or 2 discs, got {}",
-                self.discs.len()
-            ));
+    /// A new validated scene with fields changed: `changes` maps dotted paths (list indices as
+    /// numbers: `"discs.1.d_rrp"`) to JSON values; a whole sub-tree may be replaced.
+    pub fn replace(&self, changes: &[(String, serde_json::Value)]) -> Result<Self> {
+        let mut tree = self.to_value()?;
+        for (path, value) in changes {
+            set_path(&mut tree, path, value.clone())?;
         }
-        for (k, d) in self.discs.iter().enumerate() {
-            for (n, v) in [
-                ("phase", Some(d.phase)),
-                ("d_rp", d.d_rp),
-                ("d_rrp", d.d_rrp),
-                ("d_delta", d.d_delta),
-            ] {
-                if let Some(v) = v
-                    && !v.is_finite()
-                {
-                    return err(format!("discs[{k}].{n} must be finite, got {v}"));
-                }
-            }
-            crate::geometry::CycloidGeometry::check(self.disc_params(k))?;
-        }
-        if self.cranks < 1 {
-            return err("cranks must be at least 1".into());
-        }
-        if let Some(s) = &self.stage1 {
-            s.validate()?;
-            if s.planets != self.cranks {
-                return err(format!(
-                    "stage1.planets = {} must equal cranks = {} (each planet sits on a crank)",
-                    s.planets, self.cranks
-                ));
-            }
-        }
-        let zp = self.cycloid.pins as usize;
-        if !self.pin_errors.position.is_empty() && self.pin_errors.position.len() != zp {
-            return err(format!(
-                "pin_errors.position must have one (dx, dy) per pin ({zp}), got {}",
-                self.pin_errors.position.len()
-            ));
-        }
-        if !self.pin_errors.radius.is_empty() && self.pin_errors.radius.len() != zp {
-            return err(format!(
-                "pin_errors.radius must have one value per pin ({zp}), got {}",
-                self.pin_errors.radius.len()
-            ));
-        }
-        if self
-            .pin_errors
-            .position
-            .iter()
-            .flatten()
-            .chain(&self.pin_errors.radius)
-            .any(|v| !v.is_finite())
-        {
-            return err("pin_errors must be finite".into());
-        }
-        if !(self.density.is_finite() && self.density > 0.0) {
-            return err(format!("density must be > 0 kg/m^3, got {}", self.density));
-        }
-        let i = &self.inertias;
-        for (n, mp) in [
-            ("sun", i.sun),
-            ("crank", i.crank),
-            ("disc", i.disc),
-            ("carrier", i.carrier),
-        ] {
-            if let Some(mp) = mp
-                && !(mp.mass.is_finite()
-                    && mp.mass > 0.0
-                    && mp.inertia.is_finite()
-                    && mp.inertia > 0.0)
-            {
-                return err(format!(
-                    "inertias.{n} needs mass > 0 kg and inertia > 0 kg m^2, got {mp:?}"
-                ));
-            }
-        }
-        if !(i.load_inertia.is_finite() && i.load_inertia >= 0.0) {
-            return err(format!(
-                "inertias.load_inertia must be >= 0 kg m^2, got {}",
-                i.load_inertia
-            ));
-        }
-        if let Joints::Compliant {
-            eccentric_bearing,
-            crank_bearing,
-        } = self.joints
-        {
-            for (n, b) in [
-                ("eccentric_bearing", Some(eccentric_bearing)),
-                ("crank_bearing", crank_bearing),
-            ]
-            .into_iter()
-            .filter_map(|(n, b)| b.map(|b| (n, b)))
-            {
-                if !(b.stiffness.is_finite()
-                    && b.stiffness > 0.0
-                    && b.damping.is_finite()
-                    && b.damping >= 0.0
-                    && b.clearance.is_finite()
-                    && b.clearance >= 0.0)
-                {
-                    return err(format!(
-                        "joints.{n} needs stiffness > 0 N/m, damping >= 0 N s/m, clearance >= 0 m; got {b:?}"
-                    ));
-                }
-            }
-        }
-        self.contact.pin.law(self.cycloid.face_width)?;
-        if let Some(s) = &self.stage1 {
-            self.contact.mesh.law(s.face_width)?;
-        }
-        match self.drive {
-            Drive::Speed {
-                speed,
-                start,
-                ramp_time,
-            } => {
-                if !speed.is_finite() {
-                    return err(format!("drive.speed must be finite rad/s, got {speed}"));
-                }
-                if start == StartKind::Ramp && !(ramp_time.is_finite() && ramp_time > 0.0) {
-                    return err(format!(
-                        "drive.ramp_time must be > 0 s for a ramp start, got {ramp_time}"
-                    ));
-                }
-            }
-            Drive::Torque { torque, ramp_time } => {
-                if !(torque.is_finite() && ramp_time.is_finite() && ramp_time >= 0.0) {
-                    return err(format!(
-                        "drive.torque must be finite and ramp_time >= 0, got {torque}, {ramp_time}"
-                    ));
-                }
-                if self.initial == Initial::Steady {
-                    return err("initial = \"steady\" needs a speed drive (the steady speed is undefined for a torque drive)".into());
-                }
-            }
-        }
-        match &self.load {
-            Load::Idle => {}
-            Load::Constant { torque } => {
-                if !torque.is_finite() {
-                    return err(format!("load.torque must be finite N m, got {torque}"));
-                }
-            }
-            Load::Step {
-                before,
-                after,
-                time,
-            } => {
-                if !(before.is_finite() && after.is_finite() && time.is_finite()) {
-                    return err("load step values must be finite".into());
-                }
-            }
-            Load::Table { points } => {
-                if points.is_empty() {
-                    return err("load.points needs at least one (t, torque) pair".into());
-                }
-                if points.iter().flatten().any(|v| !v.is_finite()) {
-                    return err("load.points must be finite".into());
-                }
-                if points.windows(2).any(|w| w[1][0] <= w[0][0]) {
-                    return err("load.points times must increase strictly".into());
-                }
-            }
-        }
-        Ok(())
+        Self::from_value(&tree)
     }
 
     /// Geometry parameters of disc `k` (scene values with the disc's own modifications).
@@ -575,11 +398,6 @@ impl Scene {
             None => -(zp - 1.0),
         }
     }
-}
-
-/// The paper's first stage: 18/42 teeth, 3 planets, module 3 mm, 20 deg, face 30 mm.
-fn paper_stage1() -> Result<InvoluteStage> {
-    InvoluteStage::new(18, 42, 3, 3e-3, 20f64.to_radians(), 0.030)
 }
 
 #[cfg(test)]
@@ -624,6 +442,49 @@ mod tests {
             Load::Constant { torque } => assert!((torque - 43_923.0).abs() < 5.0, "{torque}"),
             _ => panic!(),
         }
+    }
+
+    #[test]
+    fn unknown_fields_are_rejected_in_tagged_enums_too() {
+        // Issue 12 D11: serde's deny_unknown_fields does not reach internally tagged enums.
+        let base = Scene::paper("idle").unwrap();
+        for (path, value) in [
+            (
+                "load",
+                r#"{"kind": "constant", "torque": 1.0, "torqe": 2.0}"#,
+            ),
+            ("load", r#"{"kind": "idle", "torque": 5.0}"#),
+            ("joints", r#"{"kind": "rigid", "stiffness": 1e9}"#),
+            (
+                "inertias.sun",
+                r#"{"mass": 1.0, "inertia": 1.0, "mas": 2.0}"#,
+            ),
+            (
+                "contact.pin",
+                r#"{"kind": "palmgren", "max_damping": 1.0, "damping_depth": 1e-5, "stiffness": 1.0}"#,
+            ),
+            ("drive.spede", "1.0"),
+        ] {
+            let v: serde_json::Value = serde_json::from_str(value).unwrap();
+            let err = base.replace(&[(path.to_string(), v)]).unwrap_err();
+            assert!(
+                matches!(err, RvdynError::Scene(_)) && err.to_string().contains("unknown"),
+                "{path}: {err}"
+            );
+        }
+        // A known field through the same path works.
+        let v = serde_json::json!({"kind": "constant", "torque": 1.0});
+        let s = base.replace(&[("load".into(), v)]).unwrap();
+        assert_eq!(s.load, Load::Constant { torque: 1.0 });
+        let s = s
+            .replace(&[("discs.1.d_rrp".into(), serde_json::json!(2e-5))])
+            .unwrap();
+        assert_eq!(s.discs[1].d_rrp, Some(2e-5));
+        assert!(
+            s.replace(&[("discs.2.d_rrp".into(), serde_json::json!(1.0))])
+                .is_err()
+        );
+        assert!(s.replace(&[("".into(), serde_json::json!(1.0))]).is_err());
     }
 
     #[test]

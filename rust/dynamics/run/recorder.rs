@@ -1,8 +1,9 @@
 //! Recording of selected channels at sample times, into flat arrays (first axis = time).
 
 use crate::dynamics::model::{Layout, ReducerModel};
-use crate::dynamics::sink::ContactSink;
+use crate::dynamics::run::sink::ContactSink;
 use crate::error::{Result, RvdynError};
+use crate::solve::Stats;
 use std::collections::BTreeMap;
 
 /// Groups of recorded quantities; a group not asked for is neither computed nor stored.
@@ -21,6 +22,26 @@ pub enum Channel {
 }
 
 impl Channel {
+    /// Every channel group, in recording order.
+    pub const ALL: [Channel; 5] = [
+        Channel::Motion,
+        Channel::Pins,
+        Channel::ContactPoints,
+        Channel::Mesh,
+        Channel::Energy,
+    ];
+
+    /// The name used in the API (`"motion"`, `"pins"`, `"contact_points"`, `"mesh"`, `"energy"`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Channel::Motion => "motion",
+            Channel::Pins => "pins",
+            Channel::ContactPoints => "contact_points",
+            Channel::Mesh => "mesh",
+            Channel::Energy => "energy",
+        }
+    }
+
     /// Parse a channel name.
     pub fn parse(name: &str) -> Result<Self> {
         Ok(match name {
@@ -49,20 +70,264 @@ impl Channel {
     }
 }
 
+/// A dimension of one sample of a channel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dim {
+    /// One per cycloid disc.
+    Discs,
+    /// One per pin (index j is the paper's pin j+1).
+    Pins,
+    /// One per crankshaft.
+    Cranks,
+    /// One per sun/planet mesh.
+    Meshes,
+    /// A plane vector (x, y), fixed frame.
+    Xy,
+}
+
+impl Dim {
+    /// The dimension's name in shapes (`"discs"`, `"pins"`, `"cranks"`, `"meshes"`, `"2"`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Dim::Discs => "discs",
+            Dim::Pins => "pins",
+            Dim::Cranks => "cranks",
+            Dim::Meshes => "meshes",
+            Dim::Xy => "2",
+        }
+    }
+
+    fn size(&self, layout: &Layout) -> usize {
+        match self {
+            Dim::Discs => layout.discs,
+            Dim::Pins => layout.pins,
+            Dim::Cranks => layout.cranks,
+            Dim::Meshes => layout.meshes,
+            Dim::Xy => 2,
+        }
+    }
+}
+
+/// Element type of a recorded channel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dtype {
+    /// 64-bit float.
+    Float64,
+    /// 64-bit integer (counts).
+    Int64,
+}
+
+/// The declaration of one recorded channel: everything the Python `Result`, its stubs and
+/// the docs say about it comes from here.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ChannelSpec {
+    /// Attribute name in the Python `Result`.
+    pub name: &'static str,
+    /// The group that records it (`None` for the time axis, always recorded).
+    pub group: Option<Channel>,
+    /// Shape of one sample (the first axis of the array is time).
+    pub shape: &'static [Dim],
+    /// SI unit (`"1"` for a number without unit).
+    pub unit: &'static str,
+    /// Element type.
+    pub dtype: Dtype,
+    /// What it is.
+    pub doc: &'static str,
+}
+
+const fn spec(
+    name: &'static str,
+    group: Option<Channel>,
+    shape: &'static [Dim],
+    unit: &'static str,
+    doc: &'static str,
+) -> ChannelSpec {
+    ChannelSpec {
+        name,
+        group,
+        shape,
+        unit,
+        dtype: Dtype::Float64,
+        doc,
+    }
+}
+
+use Channel::{ContactPoints, Energy, Mesh, Motion, Pins};
+
+/// Every recorded channel, in recording order.
+pub static CHANNELS: &[ChannelSpec] = &[
+    spec("t", None, &[], "s", "sample time"),
+    spec("sun_angle", Some(Motion), &[], "rad", "sun (input) angle"),
+    spec("sun_speed", Some(Motion), &[], "rad/s", "sun (input) speed"),
+    spec(
+        "carrier_angle",
+        Some(Motion),
+        &[],
+        "rad",
+        "carrier (output) angle",
+    ),
+    spec(
+        "carrier_speed",
+        Some(Motion),
+        &[],
+        "rad/s",
+        "carrier (output) speed",
+    ),
+    spec(
+        "crank_angle",
+        Some(Motion),
+        &[Dim::Cranks],
+        "rad",
+        "absolute rotation angle of each crankshaft",
+    ),
+    spec(
+        "crank_speed",
+        Some(Motion),
+        &[Dim::Cranks],
+        "rad/s",
+        "absolute speed of each crankshaft",
+    ),
+    spec(
+        "disc_center",
+        Some(Motion),
+        &[Dim::Discs, Dim::Xy],
+        "m",
+        "disc centres about the reducer axis",
+    ),
+    spec(
+        "disc_angle",
+        Some(Motion),
+        &[Dim::Discs],
+        "rad",
+        "disc rotation angles",
+    ),
+    spec(
+        "pin_force",
+        Some(Pins),
+        &[Dim::Discs, Dim::Pins],
+        "N",
+        "normal force of pin j on disc k (j = the paper's pin j+1)",
+    ),
+    spec(
+        "pin_penetration",
+        Some(Pins),
+        &[Dim::Discs, Dim::Pins],
+        "m",
+        "penetration of pin j into disc k",
+    ),
+    spec(
+        "pin_moment",
+        Some(Pins),
+        &[Dim::Discs, Dim::Pins],
+        "N m",
+        "moment of pin j's force about disc k's centre (z component; about the ring centre it \
+         is zp/zc times larger)",
+    ),
+    ChannelSpec {
+        name: "loaded_pins",
+        group: Some(Pins),
+        shape: &[Dim::Discs],
+        unit: "1",
+        dtype: Dtype::Int64,
+        doc: "number of pins in contact per disc",
+    },
+    spec(
+        "pin_point",
+        Some(ContactPoints),
+        &[Dim::Discs, Dim::Pins, Dim::Xy],
+        "m",
+        "contact point on the profile, fixed frame",
+    ),
+    spec(
+        "pin_normal",
+        Some(ContactPoints),
+        &[Dim::Discs, Dim::Pins, Dim::Xy],
+        "1",
+        "unit outward profile normal at the contact",
+    ),
+    spec(
+        "mesh_force",
+        Some(Mesh),
+        &[Dim::Meshes],
+        "N",
+        "sun/planet mesh force along the line of action (negative on the coast flank)",
+    ),
+    spec(
+        "mesh_deflection",
+        Some(Mesh),
+        &[Dim::Meshes],
+        "m",
+        "mesh deflection along the line of action",
+    ),
+    spec(
+        "input_torque",
+        Some(Mesh),
+        &[],
+        "N m",
+        "torque the drive applies to the input",
+    ),
+    spec(
+        "kinetic_energy",
+        Some(Energy),
+        &[],
+        "J",
+        "kinetic energy of the free bodies",
+    ),
+    spec(
+        "potential_energy",
+        Some(Energy),
+        &[],
+        "J",
+        "elastic energy in the contacts and bearings",
+    ),
+    spec(
+        "input_work",
+        Some(Energy),
+        &[],
+        "J",
+        "work done by the drive",
+    ),
+    spec(
+        "output_work",
+        Some(Energy),
+        &[],
+        "J",
+        "work done against the load",
+    ),
+    spec(
+        "dissipated_energy",
+        Some(Energy),
+        &[],
+        "J",
+        "energy dissipated by contact and bearing damping",
+    ),
+    spec(
+        "energy_residual",
+        Some(Energy),
+        &[],
+        "J",
+        "E_kin + E_el - E0 - W_in + W_out + D (0 for an exact integration)",
+    ),
+];
+
 /// One recorded array: flat data and the shape of one sample.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Series {
+    /// Samples one after the other, each row-major.
     pub data: Vec<f64>,
+    /// Shape of one sample.
     pub sample_shape: Vec<usize>,
 }
 
 /// Everything a run recorded, by name (see the Python `Result` for the meaning of each).
 #[derive(Debug, Clone, Default)]
 pub struct Recording {
+    /// Recorded arrays by channel name (see [`CHANNELS`]).
     pub series: BTreeMap<&'static str, Series>,
+    /// Number of samples.
     pub samples: usize,
     /// Integrator statistics: steps, force evaluations, Jacobians, rejected or split steps.
-    pub stats: BTreeMap<&'static str, f64>,
+    pub stats: Stats,
 }
 
 /// Collects the contacts of one evaluation into per-sample buffers.
@@ -136,52 +401,21 @@ impl Recorder {
         let nm = layout.meshes;
         let has = |c| channels.contains(&c);
         let mut series: BTreeMap<&'static str, Series> = BTreeMap::new();
-        let mut add = |name: &'static str, shape: Vec<usize>| {
+        for c in CHANNELS {
+            if c.group.is_some_and(|g| !has(g)) {
+                continue;
+            }
+            let shape: Vec<usize> = c.shape.iter().map(|d| d.size(&layout)).collect();
             let per: usize = shape.iter().product();
             series.insert(
-                name,
+                c.name,
                 Series {
-                    data: Vec::with_capacity(capacity * per),
+                    // Reserve at most 2^20 samples up front: a huge sample count from a long run
+                    // grows as it runs instead of failing an allocation at the start.
+                    data: Vec::with_capacity(capacity.min(1 << 20) * per),
                     sample_shape: shape,
                 },
             );
-        };
-        add("t", vec![]);
-        if has(Channel::Motion) {
-            for n in ["sun_angle", "sun_speed", "carrier_angle", "carrier_speed"] {
-                add(n, vec![]);
-            }
-            add("crank_angle", vec![layout.cranks]);
-            add("crank_speed", vec![layout.cranks]);
-            add("disc_center", vec![nd, 2]);
-            add("disc_angle", vec![nd]);
-        }
-        if has(Channel::Pins) {
-            add("pin_force", vec![nd, zp]);
-            add("pin_penetration", vec![nd, zp]);
-            add("pin_moment", vec![nd, zp]);
-            add("loaded_pins", vec![nd]);
-        }
-        if has(Channel::ContactPoints) {
-            add("pin_point", vec![nd, zp, 2]);
-            add("pin_normal", vec![nd, zp, 2]);
-        }
-        if has(Channel::Mesh) {
-            add("mesh_force", vec![nm]);
-            add("mesh_deflection", vec![nm]);
-            add("input_torque", vec![]);
-        }
-        if has(Channel::Energy) {
-            for n in [
-                "kinetic_energy",
-                "potential_energy",
-                "input_work",
-                "output_work",
-                "dissipated_energy",
-                "energy_residual",
-            ] {
-                add(n, vec![]);
-            }
         }
         let sink = SampleSink {
             zp,
@@ -202,7 +436,7 @@ impl Recorder {
             rec: Recording {
                 series,
                 samples: 0,
-                stats: BTreeMap::new(),
+                stats: Stats::default(),
             },
             sink,
             nd,

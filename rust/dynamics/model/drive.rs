@@ -5,7 +5,7 @@ use crate::dynamics::scene::{Drive, StartKind};
 
 /// Time law of the input.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum DriveProfile {
+pub(crate) enum DriveProfile {
     /// Prescribed speed [rad/s], reached at once (`ramp = None`) or over a cubic ramp [s].
     Speed { speed: f64, ramp: Option<f64> },
     /// Prescribed torque [N m], ramped over `ramp` [s] (0 = step).
@@ -14,7 +14,7 @@ pub enum DriveProfile {
 
 impl DriveProfile {
     /// The time law of a scene's drive.
-    pub fn new(drive: &Drive) -> Self {
+    pub(crate) fn new(drive: &Drive) -> Self {
         match *drive {
             Drive::Speed {
                 speed,
@@ -32,12 +32,12 @@ impl DriveProfile {
     }
 
     /// True for a prescribed-speed drive.
-    pub fn is_speed(&self) -> bool {
+    pub(crate) fn is_speed(&self) -> bool {
         matches!(self, DriveProfile::Speed { .. })
     }
 
     /// Full input speed [rad/s] (0 for a torque drive).
-    pub fn full_speed(&self) -> f64 {
+    pub(crate) fn full_speed(&self) -> f64 {
         match *self {
             DriveProfile::Speed { speed, .. } => speed,
             DriveProfile::Torque { .. } => 0.0,
@@ -46,7 +46,7 @@ impl DriveProfile {
 
     /// Prescribed (angle [rad], speed [rad/s], acceleration [rad/s^2]) at time `t` [s].
     /// The ramp `w(t) = W s^2 (3 - 2 s)`, `s = t/T`, integrates to `W T (s^3 - s^4/2)`.
-    pub fn motion(&self, t: f64) -> (f64, f64, f64) {
+    pub(crate) fn motion(&self, t: f64) -> (f64, f64, f64) {
         match *self {
             DriveProfile::Speed { speed, ramp: None } => (speed * t, speed, 0.0),
             DriveProfile::Speed {
@@ -70,7 +70,7 @@ impl DriveProfile {
     }
 
     /// Applied input torque [N m] at `t`, for a torque drive.
-    pub fn torque(&self, t: f64) -> Option<f64> {
+    pub(crate) fn torque(&self, t: f64) -> Option<f64> {
         match *self {
             DriveProfile::Torque { torque, ramp } => Some(if ramp > 0.0 {
                 step_cubic(t, 0.0, 0.0, ramp, torque)

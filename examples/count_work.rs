@@ -1,0 +1,57 @@
+//! A fixed amount of work for counting instructions (BENCHMARKS.md section 7), which a shared
+//! machine's load does not change as it changes times:
+//!
+//! ```sh
+//! cargo build --release --example count_work
+//! valgrind --tool=callgrind target/release/examples/count_work run 0.02 generalized-alpha rigid
+//! valgrind --tool=callgrind target/release/examples/count_work rhs 20000   # minus `rhs 0`
+//! ```
+//!
+//! `run T METHOD JOINTS`: `dynamics::simulate` of the rated default scene for T s with no
+//! channels recorded (JOINTS `rigid` or `compliant`); `rhs N`: N force evaluations of the
+//! rigid rated scene at one loaded state (after 0.05 s from rest).
+use rvdyn::dynamics::model::ReducerModel;
+use rvdyn::dynamics::system::RigidSystem;
+use rvdyn::dynamics::{RigidModel, RunControl, Scene, SimOptions, simulate};
+use rvdyn::solve::generalized_alpha::GeneralizedAlpha;
+use rvdyn::solve::{MechanicalSystem, Method, State};
+use std::hint::black_box;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let arg = |i: usize, default: &str| args.get(i).cloned().unwrap_or_else(|| default.into());
+    let mut scene = Scene::paper("rated")?;
+    if arg(1, "run") == "rhs" {
+        let n: usize = arg(2, "20000").parse()?;
+        let model = RigidModel::new(&scene)?;
+        let sys = RigidSystem::new(&model);
+        let (q, v) = sys.initial_state();
+        let mut st = State::new(&sys, 0.0, q, v)?;
+        let mut ga = GeneralizedAlpha::new(0.8, 1e-9, false)?;
+        for _ in 0..500 {
+            ga.step(&sys, &mut st, 1e-4)?;
+        }
+        let (mut a, mut p) = (vec![0.0; sys.dof()], [0.0; 3]);
+        for _ in 0..n {
+            sys.eval(
+                black_box(st.t),
+                black_box(&st.q),
+                black_box(&st.v),
+                &mut a,
+                &mut p,
+            )?;
+        }
+        println!("{n} evaluations, a = {a:?}");
+        return Ok(());
+    }
+    let t_end: f64 = arg(2, "0.02").parse()?;
+    let method = Method::parse(&arg(3, "generalized-alpha"))?;
+    if arg(4, "rigid") == "compliant" {
+        scene.joints = rvdyn::dynamics::compliant::default_joints();
+    }
+    let mut opt = SimOptions::new(t_end, method);
+    opt.channels = vec![];
+    let r = simulate(&scene, &opt, &RunControl::default())?;
+    println!("{} samples, stats {:?}", r.samples, r.stats);
+    Ok(())
+}

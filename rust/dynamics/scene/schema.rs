@@ -1,0 +1,908 @@
+//! The scene schema as a table: every field with its type, unit, default and rule. The table
+//! is the source of `docs/scene.md` ([`markdown`]); tests check it against the serde types (every
+//! field of every variant is listed, nothing else is, and each stated default is what an
+//! omitted field becomes) and against the file.
+
+/// One field of the scene schema.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Field {
+    /// Dotted path; `[]` stands for any list index (`discs[].phase`).
+    pub path: &'static str,
+    /// The variant the field belongs to (`kind = constant`), empty when always present.
+    pub when: &'static str,
+    /// JSON type: number, integer, string, object, list, ...
+    pub ty: &'static str,
+    /// SI unit (`-` for none).
+    pub unit: &'static str,
+    /// The value an omitted field takes, as JSON text; `None` = required.
+    pub default: Option<&'static str>,
+    /// The rule the value must follow (checked when the scene is built).
+    pub rule: &'static str,
+    /// What it is.
+    pub doc: &'static str,
+}
+
+const fn f(
+    path: &'static str,
+    when: &'static str,
+    ty: &'static str,
+    unit: &'static str,
+    default: Option<&'static str>,
+    rule: &'static str,
+    doc: &'static str,
+) -> Field {
+    Field {
+        path,
+        when,
+        ty,
+        unit,
+        default,
+        rule,
+        doc,
+    }
+}
+
+const REQ: Option<&str> = None;
+const ZERO: Option<&str> = Some("0.0");
+const NULL: Option<&str> = Some("null");
+
+/// Every field of a scene, in document order.
+pub static FIELDS: &[Field] = &[
+    f(
+        "name",
+        "",
+        "string",
+        "-",
+        Some("\"\""),
+        "",
+        "a label for reports",
+    ),
+    f(
+        "stage1",
+        "",
+        "object or null",
+        "-",
+        NULL,
+        "null = a single-stage cycloid drive driven at the cranks",
+        "the involute first stage (sun and planets on the cranks)",
+    ),
+    f("stage1.z_sun", "", "integer", "-", REQ, ">= 5", "sun teeth"),
+    f(
+        "stage1.z_planet",
+        "",
+        "integer",
+        "-",
+        REQ,
+        ">= 5",
+        "teeth of each planet",
+    ),
+    f(
+        "stage1.planets",
+        "",
+        "integer",
+        "-",
+        REQ,
+        "= cranks; planets must not collide",
+        "number of planets (equally spaced)",
+    ),
+    f("stage1.module", "", "number", "m", REQ, "> 0", "module"),
+    f(
+        "stage1.pressure_angle",
+        "",
+        "number",
+        "rad",
+        REQ,
+        "in (0, 45) deg",
+        "pressure angle",
+    ),
+    f(
+        "stage1.face_width",
+        "",
+        "number",
+        "m",
+        REQ,
+        "> 0",
+        "face width of the mesh",
+    ),
+    f(
+        "stage1.backlash",
+        "",
+        "number",
+        "m",
+        ZERO,
+        ">= 0",
+        "total backlash of one mesh along the line of action",
+    ),
+    f(
+        "cycloid",
+        "",
+        "object",
+        "-",
+        REQ,
+        "a valid disc: curtate ratio e zp / (rp + d_rp) < 1, no pin overlap, no undercut",
+        "cycloid disc geometry and the default profile modifications",
+    ),
+    f(
+        "cycloid.pins",
+        "",
+        "integer",
+        "-",
+        REQ,
+        ">= 3",
+        "number of pins zp (the disc has zp - 1 lobes)",
+    ),
+    f(
+        "cycloid.eccentricity",
+        "",
+        "number",
+        "m",
+        REQ,
+        "> 0",
+        "eccentricity e",
+    ),
+    f(
+        "cycloid.pin_circle_radius",
+        "",
+        "number",
+        "m",
+        REQ,
+        "> 0",
+        "pin circle radius rp",
+    ),
+    f(
+        "cycloid.pin_radius",
+        "",
+        "number",
+        "m",
+        REQ,
+        "> 0, pins must not overlap",
+        "pin radius rrp",
+    ),
+    f(
+        "cycloid.face_width",
+        "",
+        "number",
+        "m",
+        REQ,
+        "> 0",
+        "disc face width",
+    ),
+    f(
+        "cycloid.d_rp",
+        "",
+        "number",
+        "m",
+        ZERO,
+        "finite",
+        "shift modification (grinding convention: rp -> rp + d_rp)",
+    ),
+    f(
+        "cycloid.d_rrp",
+        "",
+        "number",
+        "m",
+        ZERO,
+        "finite",
+        "equidistant modification (rrp -> rrp + d_rrp; positive removes material)",
+    ),
+    f(
+        "cycloid.d_delta",
+        "",
+        "number",
+        "rad",
+        ZERO,
+        "finite",
+        "rotation modification (the profile turned by this angle)",
+    ),
+    f(
+        "discs",
+        "",
+        "list of objects",
+        "-",
+        REQ,
+        "1 or 2 discs",
+        "the discs on the crank eccentrics",
+    ),
+    f(
+        "discs[].phase",
+        "",
+        "number",
+        "rad",
+        REQ,
+        "finite",
+        "phase of this disc's eccentric on the crank (0 and pi for the two-disc RV)",
+    ),
+    f(
+        "discs[].d_rp",
+        "",
+        "number or null",
+        "m",
+        NULL,
+        "finite; null = cycloid.d_rp",
+        "this disc's shift modification",
+    ),
+    f(
+        "discs[].d_rrp",
+        "",
+        "number or null",
+        "m",
+        NULL,
+        "finite; null = cycloid.d_rrp",
+        "this disc's equidistant modification",
+    ),
+    f(
+        "discs[].d_delta",
+        "",
+        "number or null",
+        "rad",
+        NULL,
+        "finite; null = cycloid.d_delta",
+        "this disc's rotation modification",
+    ),
+    f(
+        "cranks",
+        "",
+        "integer",
+        "-",
+        REQ,
+        ">= 1; = stage1.planets",
+        "number of crankshafts",
+    ),
+    f(
+        "pin_errors",
+        "",
+        "object",
+        "-",
+        Some("{\"position\": [], \"radius\": []}"),
+        "",
+        "pin manufacturing errors (index j = the paper's pin j+1)",
+    ),
+    f(
+        "pin_errors.position",
+        "",
+        "list of [dx, dy]",
+        "m",
+        Some("[]"),
+        "empty or one per pin; finite",
+        "position error of each pin centre, fixed frame",
+    ),
+    f(
+        "pin_errors.radius",
+        "",
+        "list of numbers",
+        "m",
+        Some("[]"),
+        "empty or one per pin; finite",
+        "radius error of each pin (positive = larger pin)",
+    ),
+    f(
+        "density",
+        "",
+        "number",
+        "kg/m^3",
+        REQ,
+        "> 0",
+        "material density for the computed inertias",
+    ),
+    f(
+        "inertias",
+        "",
+        "object",
+        "-",
+        Some(
+            "{\"sun\": null, \"crank\": null, \"disc\": null, \"carrier\": null, \"load_inertia\": 0.0}",
+        ),
+        "",
+        "mass properties of the bodies (null = computed from the geometry)",
+    ),
+    f(
+        "inertias.sun",
+        "",
+        "object or null",
+        "-",
+        NULL,
+        "",
+        "sun gear and input shaft (inertia about the reducer axis)",
+    ),
+    f("inertias.sun.mass", "", "number", "kg", REQ, "> 0", "mass"),
+    f(
+        "inertias.sun.inertia",
+        "",
+        "number",
+        "kg m^2",
+        REQ,
+        "> 0",
+        "moment of inertia",
+    ),
+    f(
+        "inertias.crank",
+        "",
+        "object or null",
+        "-",
+        NULL,
+        "",
+        "one crankshaft with its planet and eccentrics (inertia about the crank axis)",
+    ),
+    f(
+        "inertias.crank.mass",
+        "",
+        "number",
+        "kg",
+        REQ,
+        "> 0",
+        "mass",
+    ),
+    f(
+        "inertias.crank.inertia",
+        "",
+        "number",
+        "kg m^2",
+        REQ,
+        "> 0",
+        "moment of inertia",
+    ),
+    f(
+        "inertias.disc",
+        "",
+        "object or null",
+        "-",
+        NULL,
+        "",
+        "one cycloid disc (inertia about its centre)",
+    ),
+    f("inertias.disc.mass", "", "number", "kg", REQ, "> 0", "mass"),
+    f(
+        "inertias.disc.inertia",
+        "",
+        "number",
+        "kg m^2",
+        REQ,
+        "> 0",
+        "moment of inertia",
+    ),
+    f(
+        "inertias.carrier",
+        "",
+        "object or null",
+        "-",
+        NULL,
+        "",
+        "carrier (output) with everything bolted to it (inertia about the reducer axis)",
+    ),
+    f(
+        "inertias.carrier.mass",
+        "",
+        "number",
+        "kg",
+        REQ,
+        "> 0",
+        "mass",
+    ),
+    f(
+        "inertias.carrier.inertia",
+        "",
+        "number",
+        "kg m^2",
+        REQ,
+        "> 0",
+        "moment of inertia",
+    ),
+    f(
+        "inertias.load_inertia",
+        "",
+        "number",
+        "kg m^2",
+        ZERO,
+        ">= 0",
+        "extra load inertia on the output",
+    ),
+    f(
+        "joints",
+        "",
+        "object",
+        "-",
+        REQ,
+        "",
+        "the crank-eccentric/disc and crank/carrier bearings",
+    ),
+    f(
+        "joints.kind",
+        "",
+        "string",
+        "-",
+        REQ,
+        "\"rigid\" or \"compliant\"",
+        "ideal joints (the paper) or spring-damper bearings",
+    ),
+    f(
+        "joints.eccentric_bearing",
+        "kind = compliant",
+        "object",
+        "-",
+        REQ,
+        "",
+        "needle bearing between each eccentric and its disc hole",
+    ),
+    f(
+        "joints.eccentric_bearing.stiffness",
+        "",
+        "number",
+        "N/m",
+        REQ,
+        "> 0",
+        "radial stiffness",
+    ),
+    f(
+        "joints.eccentric_bearing.damping",
+        "",
+        "number",
+        "N s/m",
+        REQ,
+        ">= 0",
+        "radial damping",
+    ),
+    f(
+        "joints.eccentric_bearing.clearance",
+        "",
+        "number",
+        "m",
+        ZERO,
+        ">= 0",
+        "radial clearance",
+    ),
+    f(
+        "joints.crank_bearing",
+        "kind = compliant",
+        "object or null",
+        "-",
+        NULL,
+        "null = rigid crank bearings",
+        "bearing between each crankshaft and the carrier",
+    ),
+    f(
+        "joints.crank_bearing.stiffness",
+        "",
+        "number",
+        "N/m",
+        REQ,
+        "> 0",
+        "radial stiffness",
+    ),
+    f(
+        "joints.crank_bearing.damping",
+        "",
+        "number",
+        "N s/m",
+        REQ,
+        ">= 0",
+        "radial damping",
+    ),
+    f(
+        "joints.crank_bearing.clearance",
+        "",
+        "number",
+        "m",
+        ZERO,
+        ">= 0",
+        "radial clearance",
+    ),
+    f(
+        "contact",
+        "",
+        "object",
+        "-",
+        REQ,
+        "",
+        "contact laws per contact family",
+    ),
+    f(
+        "contact.pin",
+        "",
+        "object",
+        "-",
+        REQ,
+        "",
+        "law of the pin / cycloid profile contacts",
+    ),
+    f(
+        "contact.mesh",
+        "",
+        "object",
+        "-",
+        REQ,
+        "",
+        "law of the sun / planet meshes (along the line of action)",
+    ),
+    f(
+        "contact.*.kind",
+        "",
+        "string",
+        "-",
+        REQ,
+        "\"impact\" or \"palmgren\"",
+        "ADAMS IMPACT law, or steel line contact from the face width (Palmgren)",
+    ),
+    f(
+        "contact.*.stiffness",
+        "kind = impact",
+        "number",
+        "N/m^exponent",
+        REQ,
+        "> 0",
+        "IMPACT stiffness k",
+    ),
+    f(
+        "contact.*.exponent",
+        "kind = impact",
+        "number",
+        "-",
+        REQ,
+        ">= 1",
+        "IMPACT force exponent e",
+    ),
+    f(
+        "contact.*.max_damping",
+        "",
+        "number",
+        "N s/m",
+        REQ,
+        ">= 0",
+        "full damping cmax",
+    ),
+    f(
+        "contact.*.damping_depth",
+        "",
+        "number",
+        "m",
+        REQ,
+        "> 0",
+        "penetration at which the full damping acts",
+    ),
+    f(
+        "drive",
+        "",
+        "object",
+        "-",
+        REQ,
+        "",
+        "the drive on the input (sun, or the cranks without a first stage)",
+    ),
+    f(
+        "drive.kind",
+        "",
+        "string",
+        "-",
+        REQ,
+        "\"speed\" or \"torque\"",
+        "prescribed input speed, or prescribed input torque (the input is then free)",
+    ),
+    f(
+        "drive.speed",
+        "kind = speed",
+        "number",
+        "rad/s",
+        REQ,
+        "finite",
+        "input speed",
+    ),
+    f(
+        "drive.start",
+        "kind = speed",
+        "string",
+        "-",
+        REQ,
+        "\"step\" or \"ramp\"",
+        "full speed from t = 0, or a smooth cubic ramp",
+    ),
+    f(
+        "drive.ramp_time",
+        "kind = speed",
+        "number",
+        "s",
+        ZERO,
+        "> 0 for a ramp start",
+        "ramp duration",
+    ),
+    f(
+        "drive.torque",
+        "kind = torque",
+        "number",
+        "N m",
+        REQ,
+        "finite",
+        "input torque",
+    ),
+    f(
+        "drive.ramp_time",
+        "kind = torque",
+        "number",
+        "s",
+        ZERO,
+        ">= 0",
+        "ramp duration of the torque",
+    ),
+    f(
+        "load",
+        "",
+        "object",
+        "-",
+        REQ,
+        "",
+        "load torque on the carrier (against positive output rotation)",
+    ),
+    f(
+        "load.kind",
+        "",
+        "string",
+        "-",
+        REQ,
+        "\"idle\", \"constant\", \"step\" or \"table\"",
+        "the load law",
+    ),
+    f(
+        "load.torque",
+        "kind = constant",
+        "number",
+        "N m",
+        REQ,
+        "finite",
+        "constant torque from t = 0",
+    ),
+    f(
+        "load.before",
+        "kind = step",
+        "number",
+        "N m",
+        REQ,
+        "finite",
+        "torque before the step",
+    ),
+    f(
+        "load.after",
+        "kind = step",
+        "number",
+        "N m",
+        REQ,
+        "finite",
+        "torque after the step",
+    ),
+    f(
+        "load.time",
+        "kind = step",
+        "number",
+        "s",
+        REQ,
+        "finite",
+        "time of the step",
+    ),
+    f(
+        "load.points",
+        "kind = table",
+        "list of [t, torque]",
+        "s, N m",
+        REQ,
+        "at least one; times strictly increasing; finite",
+        "piecewise-linear table, held constant outside",
+    ),
+    f(
+        "initial",
+        "",
+        "string",
+        "-",
+        REQ,
+        "\"rest\" or \"steady\" (steady needs a speed drive)",
+        "everything at rest in the kinematic pose, or every body at its kinematic speed",
+    ),
+];
+
+/// The table as the Markdown of `docs/scene.md`.
+pub fn markdown() -> String {
+    let mut s = String::from(
+        "# Scene fields\n\n\
+         Generated from `rust/dynamics/scene/schema.rs` (the test \
+         `scene_table_matches_docs` fails when this file and the code disagree; regenerate \
+         with `cargo test scene_table -- --ignored`).\n\n\
+         A scene is a JSON or TOML document (`rvdyn.Scene`); every value is SI. A field \
+         marked *required* must be given; an omitted optional field takes its default. \
+         Paths are dotted, `[]` stands for a list index, `contact.*` for `contact.pin` and \
+         `contact.mesh`; \"when\" names the variant (`kind`) a field belongs to. A field that \
+         is not in this table is an error. The default scene (`Scene.paper`) and where each \
+         of its values comes from are in [model.md](model.md#default-scene).\n\n\
+         | field | when | type | unit | default | rule | meaning |\n\
+         |---|---|---|---|---|---|---|\n",
+    );
+    for x in FIELDS {
+        let default = x
+            .default
+            .map_or("*required*".to_string(), |d| format!("`{d}`"));
+        let when = if x.when.is_empty() { "" } else { x.when };
+        s.push_str(&format!(
+            "| `{}` | {} | {} | {} | {} | {} | {} |\n",
+            x.path, when, x.ty, x.unit, default, x.rule, x.doc
+        ));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::scene::Scene;
+    use serde_json::{Value, json};
+    use std::collections::BTreeSet;
+
+    /// Scenes that together use every variant and every optional object.
+    fn examples() -> Vec<Value> {
+        let base = Scene::paper("rated").unwrap().to_value().unwrap();
+        let mut out = vec![base.clone()];
+        let mut v = base.clone();
+        v["stage1"] = Value::Null;
+        v["joints"] = json!({"kind": "compliant",
+            "eccentric_bearing": {"stiffness": 1e9, "damping": 1e4, "clearance": 0.0},
+            "crank_bearing": {"stiffness": 2e9, "damping": 1e4, "clearance": 0.0}});
+        v["contact"]["pin"] =
+            json!({"kind": "palmgren", "max_damping": 1e5, "damping_depth": 1e-5});
+        v["drive"] = json!({"kind": "torque", "torque": 10.0, "ramp_time": 0.0});
+        v["load"] = json!({"kind": "step", "before": 0.0, "after": 1.0, "time": 0.1});
+        v["inertias"] = json!({"sun": {"mass": 1.0, "inertia": 1.0}, "crank": {"mass": 1.0, "inertia": 1.0},
+            "disc": {"mass": 1.0, "inertia": 1.0}, "carrier": {"mass": 1.0, "inertia": 1.0},
+            "load_inertia": 0.0});
+        v["discs"][0]["d_rp"] = json!(0.0);
+        out.push(v);
+        let mut v = base.clone();
+        v["load"] = json!({"kind": "table", "points": [[0.0, 0.0], [1.0, 1.0]]});
+        out.push(v);
+        let mut v = base;
+        v["load"] = json!({"kind": "idle"});
+        out.push(v);
+        out
+    }
+
+    /// (path, when) of every node of a scene tree, in the table's notation.
+    fn nodes(v: &Value, prefix: &str, out: &mut BTreeSet<(String, String)>) {
+        let Value::Object(m) = v else { return };
+        let kind = m.get("kind").and_then(Value::as_str);
+        for (k, child) in m {
+            let path = if prefix.is_empty() {
+                k.clone()
+            } else {
+                format!("{prefix}.{k}")
+            };
+            let path = path
+                .replace("contact.pin.", "contact.*.")
+                .replace("contact.mesh.", "contact.*.");
+            // Direct children of a tagged object belong to its variant.
+            let when = match kind {
+                Some(kind) if k != "kind" => format!("kind = {kind}"),
+                _ => String::new(),
+            };
+            out.insert((path.clone(), when));
+            match child {
+                Value::Array(items) if items.iter().all(Value::is_object) => {
+                    for item in items {
+                        nodes(item, &format!("{path}[]"), out);
+                    }
+                }
+                _ => nodes(child, &path, out),
+            }
+        }
+    }
+
+    /// The table's (path, when) pairs.
+    fn table_keys() -> BTreeSet<(String, String)> {
+        FIELDS
+            .iter()
+            .map(|x| (x.path.to_string(), x.when.to_string()))
+            .collect()
+    }
+
+    #[test]
+    fn every_field_is_in_the_table_and_nothing_else() {
+        let mut found = BTreeSet::new();
+        for e in examples() {
+            Scene::from_value(&e).expect("example scenes are valid");
+            nodes(&e, "", &mut found);
+        }
+        // Damping fields are common to both contact laws: listed once, without a variant.
+        let found: BTreeSet<(String, String)> = found
+            .into_iter()
+            .map(|(p, w)| {
+                if p.ends_with("max_damping") || p.ends_with("damping_depth") {
+                    (p, String::new())
+                } else {
+                    (p, w)
+                }
+            })
+            .collect();
+        let table = table_keys();
+        let missing: Vec<_> = found.difference(&table).collect();
+        let extra: Vec<_> = table.difference(&found).collect();
+        assert!(missing.is_empty(), "fields not in the table: {missing:?}");
+        assert!(extra.is_empty(), "table rows that are no field: {extra:?}");
+    }
+
+    /// Remove the field at `path` (table notation, `[]` = index 0) from a tree.
+    fn remove(tree: &mut Value, path: &str) -> bool {
+        let path = path.replace("[]", ".0");
+        let keys: Vec<&str> = path.split('.').collect();
+        let (last, parents) = keys.split_last().unwrap();
+        let mut node = tree;
+        for k in parents {
+            node = match node {
+                Value::Object(m) => match m.get_mut(*k) {
+                    Some(n) => n,
+                    None => return false,
+                },
+                Value::Array(a) => match a.get_mut(k.parse::<usize>().unwrap()) {
+                    Some(n) => n,
+                    None => return false,
+                },
+                _ => return false,
+            };
+        }
+        node.as_object_mut()
+            .is_some_and(|m| m.remove(*last).is_some())
+    }
+
+    #[test]
+    fn stated_defaults_are_what_omitted_fields_become() {
+        let mut checked = 0;
+        for x in FIELDS {
+            for example in examples() {
+                for concrete in [x.path.replace("contact.*", "contact.pin")] {
+                    let mut tree = example.clone();
+                    if x.when.is_empty() || {
+                        let parent = concrete.rsplit_once('.').map_or("", |p| p.0);
+                        let kind =
+                            crate::dynamics::scene::get_path(&tree, &format!("{parent}.kind"))
+                                .ok()
+                                .and_then(Value::as_str)
+                                .map(|k| format!("kind = {k}"));
+                        kind.as_deref() == Some(x.when)
+                    } {
+                        if !remove(&mut tree, &concrete) {
+                            continue;
+                        }
+                        let built = Scene::from_value(&tree);
+                        match x.default {
+                            None => assert!(built.is_err(), "{} is required", x.path),
+                            Some(d) => {
+                                let back = built
+                                    .unwrap_or_else(|e| panic!("{} omitted: {e}", x.path))
+                                    .to_value()
+                                    .unwrap();
+                                let got = crate::dynamics::scene::get_path(
+                                    &back,
+                                    &concrete.replace("[]", ".0"),
+                                )
+                                .unwrap();
+                                let want: Value = serde_json::from_str(d).unwrap();
+                                assert_eq!(got, &want, "default of {}", x.path);
+                            }
+                        }
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked >= FIELDS.len(), "only {checked} checks");
+    }
+
+    #[test]
+    fn scene_table_matches_docs() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/scene.md");
+        let text = std::fs::read_to_string(path).unwrap_or_default();
+        assert!(
+            text == markdown(),
+            "docs/scene.md differs from the schema table: run `cargo test scene_table -- --ignored`"
+        );
+    }
+
+    #[test]
+    #[ignore = "writes docs/scene.md"]
+    fn scene_table_write_docs() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/scene.md");
+        std::fs::create_dir_all(concat!(env!("CARGO_MANIFEST_DIR"), "/docs")).unwrap();
+        std::fs::write(path, markdown()).unwrap();
+    }
+}
