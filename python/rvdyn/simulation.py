@@ -85,9 +85,8 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     bound on the gap from the last exact query and the disc's motion since); the answer is the
     same either way, ``False`` exists to measure the saving.
     step_check: what a fixed step that cannot be accurate for the scene does (fewer than 8 steps
-    per pin-mesh period, or fewer than 2 per period of the fastest mode at the start):
-    ``"warn"`` (default, a ``RuntimeWarning``), ``"raise"`` (:class:`rvdyn.ParameterError`) or
-    ``"off"``.
+    per pin-mesh period): ``"warn"`` (default, a ``RuntimeWarning``), ``"raise"``
+    (:class:`rvdyn.ParameterError`) or ``"off"``.
     h_min, max_steps: smallest step [s] (default 1e-13 s) and most steps (default 1e8) of an
     adaptive integrator; beyond either the run stops with :class:`rvdyn.SimulationError`.
 
