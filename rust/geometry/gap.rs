@@ -131,6 +131,9 @@ pub struct GapWarmStart {
     phi: f64,
     disc_angle: f64,
     cos_sin: [f64; 2],
+    /// How far the foot moved along the curve, beyond the disc's rotation, at the last query
+    /// [rad]: the next query expects the same (a linear predictor along a trajectory).
+    drift: f64,
 }
 
 impl Default for GapWarmStart {
@@ -139,6 +142,7 @@ impl Default for GapWarmStart {
             phi: f64::NAN,
             disc_angle: f64::NAN,
             cos_sin: [1.0, 0.0],
+            drift: 0.0,
         }
     }
 }
@@ -301,9 +305,10 @@ impl CycloidGeometry {
     }
 
     /// As [`CycloidGeometry::gap_with_pin_radius`] for one pin in a sequence of queries (a
-    /// trajectory): the foot of the previous query, turned by the disc's rotation since, seeds
-    /// the iteration without any trigonometry; the first query, and one after the disc turned
-    /// by 0.01 rad or more, are seeded by the polyline. `warm` is updated. The result does not
+    /// trajectory): the foot of the previous query, turned by the disc's rotation since and by
+    /// the drift of the foot at the previous query (a linear predictor), seeds the iteration
+    /// without any trigonometry; the first query, and one after the disc turned by 0.01 rad or
+    /// more, are seeded by the polyline. `warm` is updated. The result does not
     /// depend on the warm start (the iteration converges to 1e-14 m on the exact curve).
     pub fn gap_warm(
         &self,
@@ -314,19 +319,23 @@ impl CycloidGeometry {
         warm: &mut GapWarmStart,
     ) -> Result<PinGap> {
         let (p, sc) = self.to_local(pin_center, disc_center, disc_angle)?;
-        // The pin is fixed, so its kinematic parameter turns by minus the disc's rotation.
+        // The pin is fixed, so its kinematic parameter turns by minus the disc's rotation; the
+        // foot moves by that plus about the drift it had at the last query.
         let rot = warm.disc_angle - disc_angle;
-        let foot = if rot.abs() < 0.01 {
-            let (s, c) = small_sin_cos(rot);
-            self.foot_with_fallback_cs(p, warm.phi + rot, cmul(warm.cos_sin, [c, s]))
+        let turn_by = rot + warm.drift;
+        let foot = if turn_by.abs() < 0.01 {
+            let (s, c) = small_sin_cos(turn_by);
+            self.foot_with_fallback_cs(p, warm.phi + turn_by, cmul(warm.cos_sin, [c, s]))
         } else {
             self.seed.seed(p).and_then(|seed| self.foot(p, seed))
         }
         .ok_or_else(|| self.no_foot(p))?;
+        let drift = foot.phi - (warm.phi + rot);
         *warm = GapWarmStart {
             phi: foot.phi,
             disc_angle,
             cos_sin: foot.cos_sin,
+            drift: if drift.abs() < 1e-3 { drift } else { 0.0 },
         };
         Ok(self.to_global(&foot, pin_radius, disc_center, sc))
     }
