@@ -690,8 +690,8 @@ mod tests {
 
     #[test]
     fn modifications_open_the_first_order_clearance() {
-        // notes/physics.md 1.3: g0(phi) = d_rrp - d_rp (1 - K1 cos phi)/S at the kinematic pose,
-        // phi = mesh angle of the pin from the eccentricity direction.
+        // docs/model.md (modifications): g0(phi) = d_rrp - d_rp (1 - K1 cos phi)/S at the
+        // kinematic pose, phi = mesh angle of the pin from the eccentricity direction.
         let (d_rp, d_rrp) = (-2e-5, 2e-5);
         let mut p = paper_params();
         p.d_rp = d_rp;
@@ -711,7 +711,7 @@ mod tests {
             worst = worst.max((gap - first_order).abs());
             assert!(gap > 0.0);
         }
-        // Second-order remainder: ~3e-5 mm for 0.02 mm modifications (notes 1.3).
+        // Second-order remainder: ~3e-5 mm for 0.02 mm modifications (docs/model.md).
         assert!(worst < 1e-7, "worst deviation from first order {worst:e} m");
         assert!(
             worst > 1e-10,
