@@ -51,6 +51,7 @@ fn simulate_compliant_records_all_channels() {
         Channel::ContactPoints,
         Channel::Mesh,
         Channel::Energy,
+        Channel::Bearings,
     ];
     let r = simulate(&s, &opt, &RunControl::default()).unwrap();
     assert_eq!(r.samples, 21);
@@ -79,6 +80,11 @@ fn simulate_compliant_records_all_channels() {
         ("output_work", &[]),
         ("dissipated_energy", &[]),
         ("energy_residual", &[]),
+        ("pin_friction_power", &[]),
+        ("mesh_friction_power", &[]),
+        ("bearing_friction_power", &[]),
+        ("crank_bearing_force", &[3, 2]),
+        ("eccentric_bearing_force", &[3, 2, 2]),
     ];
     assert_eq!(r.series.len(), expected.len());
     for (name, shape) in expected {

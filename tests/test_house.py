@@ -126,7 +126,7 @@ def test_result_save_load_keeps_options_and_never_unpickles(tmp_path: Path) -> N
 def test_channels_come_from_the_core_registry() -> None:
     attrs = {n for n in dir(Result) if isinstance(getattr(Result, n), rvdyn.result._Channel)}
     assert attrs == set(CHANNEL_SPECS)
-    r = simulate(Scene.paper("rated"), 1e-3, channels=["motion", "pins", "contact_points", "mesh", "energy"])
+    r = simulate(Scene.paper("rated"), 1e-3, channels=["motion", "pins", "contact_points", "mesh", "energy", "bearings"])
     assert set(r.channels) == set(CHANNEL_SPECS)
     layout = {"discs": 2, "pins": 24, "cranks": 3, "meshes": 3, "2": 2}
     for name, spec in CHANNEL_SPECS.items():

@@ -17,6 +17,8 @@ Scene, Options, simulate, sweep, Result
     Reducer scenes, run options, dynamic runs (one or many in parallel) and their recorded
     results. The theory is in the repository's ``docs/model.md``, the user guide in
     ``docs/guide.md``.
+study
+    Tolerance studies (Monte Carlo / Latin hypercube, threads / processes / Dask / Ray).
 rvdyn.plotting
     Matplotlib figures (geometry, contact stiffness).
 """
@@ -56,6 +58,7 @@ from .errors import (
     SceneError,
     SimulationError,
 )
+from . import study  # noqa: E402  (rvdyn.study(...) runs a tolerance study; see rvdyn.study)
 
 __version__: str = _core.__version__
 
@@ -66,6 +69,7 @@ __all__ = [
     "Options",
     "simulate",
     "sweep",
+    "study",
     "INTEGRATORS",
     "CycloidGeometry",
     "InvoluteStage",

@@ -323,6 +323,13 @@ class CompiledScene:
     @staticmethod
     def paper(load: str) -> CompiledScene:
         """The default scene; load is "idle", "paper" or "rated"."""
+    @staticmethod
+    def physical(load: str) -> CompiledScene:
+        """The physical preset; load is "idle", "paper" or "rated"."""
+    def physics_summary(self) -> str:
+        """The contact physics at the rated operating point, as JSON text."""
+    def bearing_ratings(self) -> tuple[float | None, float | None]:
+        """ISO 281 load ratings [N] of the eccentric and crank roller bearings (None if linear)."""
     def to_json(self, indent: bool = True) -> str:
         """The scene as JSON text."""
     def to_toml(self) -> str:
@@ -348,10 +355,10 @@ class Options:
     dt [s] (None = the integrator's default: 1e-4, 1e-5 (initial), 1e-6 (initial), 1e-5 s);
     rtol (adaptive, velocities, default 1e-6); atol [m] (displacement tolerance, default
     1e-9 m); rho_inf in [0, 1] (default 0.8); record_interval [s] (None = 1e-4 s); max_samples
-    (default 50 000); channels (groups: "motion", "pins", "contact_points", "mesh", "energy";
-    None = all but contact points); skip_separated (default True); step_check ("warn",
-    "raise" or "off": a fixed step that cannot be accurate, default "warn"); h_min [s] and
-    max_steps (bounds of an adaptive method, default 1e-13 s and 1e8).
+    (default 50 000); channels (groups: "motion", "pins", "contact_points", "mesh", "energy",
+    "bearings"; None = all but contact points); skip_separated (default True); step_check
+    ("warn", "raise" or "off": a fixed step that cannot be accurate, default "warn"); h_min [s]
+    and max_steps (bounds of an adaptive method, default 1e-13 s and 1e8).
     """
 
     def __new__(

@@ -13,7 +13,13 @@ Every error of the Rust core is raised as one of these classes (the mapping live
 ``SimulationError`` a dynamic run that cannot go on (``RuntimeError``)
 ==================  ==========================================================
 
-A run interrupted with Ctrl-C raises the built-in ``KeyboardInterrupt``.
+A run interrupted with Ctrl-C raises the built-in ``KeyboardInterrupt``. A result too large
+for memory (e.g. a broadcast of two long arrays into a 2**40-element grid) raises the built-in
+``MemoryError`` before anything is computed, as numpy does. An argument of the wrong type (a
+dict where a number belongs) raises ``TypeError``, as everywhere in Python; a value of the right
+kind that cannot be read (an integer beyond the float range or a count beyond 2**32 - 1, a
+string that is not a number) raises ``ParameterError`` with Python's own error chained as its
+``__cause__``.
 """
 
 from __future__ import annotations

@@ -10,7 +10,8 @@ All inputs are SI (m, rad); axes show millimetres where that reads better, label
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, Sequence
+import operator
+from typing import TYPE_CHECKING, Any, Iterable, Sequence
 
 import numpy as np
 
@@ -21,13 +22,69 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["plot_geometry", "plot_stiffness", "new_figure", "save_figure"]
+__all__ = ["plot_geometry", "plot_stiffness", "new_figure", "save_figure", "pin_indices"]
 
 #: The paper's stiffness maxima (section 3.2), printed as N/mm^2, read as N/mm^1.5
 #: (design.md erratum 4), "near 5 mm" contact width.
 PAPER_STIFFNESS_MAXIMA = {"convex-convex": 3.988e5, "convex-concave": 5.093e5}
 PAPER_STIFFNESS_WIDTH = 5e-3
 _PER_MM15 = 1000.0**1.5
+
+
+#: Most profile points per lobe a geometry plot draws (a finer outline is invisible).
+MAX_SAMPLES_PER_LOBE = 10_000
+
+
+def _real(name: str, value: Any) -> float:
+    """``value`` as a finite float; a value Python cannot convert (a string, an int beyond the
+    float range) or a non-finite one is a ParameterError (the conversion error chained); a
+    wrong type stays a TypeError."""
+    try:
+        x = float(value)
+    except (OverflowError, ValueError) as e:
+        raise ParameterError(f"{name} must be a finite real number, got {_short(value)}") from e
+    if not math.isfinite(x):
+        raise ParameterError(f"{name} must be a finite real number, got {x!r}")
+    return x
+
+
+def _whole(name: str, value: Any, lo: int, hi: int) -> int:
+    """``value`` as an int in ``[lo, hi]`` (Python or numpy integers; not bool or float)."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"{name} must be a whole number from {lo} to {hi}, got {value!r}")
+    try:
+        n = operator.index(value)
+    except TypeError as e:
+        raise ParameterError(
+            f"{name} must be a whole number from {lo} to {hi}, got {_short(value)}"
+        ) from e
+    if not lo <= n <= hi:
+        raise ParameterError(f"{name} must be a whole number from {lo} to {hi}, got {_short(n)}")
+    return n
+
+
+def _short(value: Any, limit: int = 40) -> str:
+    """``repr(value)`` cut to ``limit`` characters (a 400-digit int prints as 40)."""
+    try:
+        text = repr(value)
+    except Exception:  # pragma: no cover - a repr that raises
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= limit else text[:limit] + "..."
+
+
+def pin_indices(pins: Iterable[Any], zp: int) -> list[int]:
+    """0-based indices of the paper's 1-based pin numbers ``pins`` on a ring of ``zp`` pins.
+
+    Raises ParameterError for a number that is not a whole number from 1 to zp (0, -1 or NaN
+    would otherwise pick a pin by Python's negative indexing under a wrong label).
+    """
+    try:
+        numbers = list(pins)
+    except TypeError as e:
+        raise ParameterError(
+            f"pins must be an iterable of pin numbers 1..{zp}, got {_short(pins)}"
+        ) from e
+    return [_whole("pin number", p, 1, zp) - 1 for p in numbers]
 
 
 def new_figure(figsize: tuple[float, float] = (7.0, 7.0)) -> tuple[Figure, Axes]:
@@ -91,12 +148,12 @@ def plot_geometry(
     -------
     matplotlib.figure.Figure
     """
-    if disc not in ("both", "front", "rear"):
-        raise ParameterError(f'disc must be "both", "front" or "rear", got {disc!r}')
-    if not math.isfinite(psi):
-        raise ParameterError(f"psi must be a finite crank angle [rad], got {psi}")
-    if samples_per_lobe < 4:
-        raise ParameterError(f"samples_per_lobe must be at least 4, got {samples_per_lobe}")
+    if not isinstance(disc, str) or disc not in ("both", "front", "rear"):
+        raise ParameterError(f'disc must be "both", "front" or "rear", got {_short(disc)}')
+    psi = _real("psi (crank angle [rad])", psi)
+    samples_per_lobe = _whole("samples_per_lobe", samples_per_lobe, 4, MAX_SAMPLES_PER_LOBE)
+    if geometry is not None and not isinstance(geometry, _core.CycloidGeometry):
+        raise TypeError(f"geometry must be a CycloidGeometry or None, got {type(geometry).__name__}")
     from matplotlib.patches import Circle, Polygon
 
     g = geometry if geometry is not None else _core.CycloidGeometry.paper()
@@ -185,14 +242,24 @@ def plot_stiffness(
     formulas the curves decrease with width, so that maximum is at the narrowest width (an
     interior maximum, if one exists, would be marked the same way).
     """
-    r1 = _core.PAPER_STIFFNESS_R1 if r1 is None else float(r1)
-    r2 = _core.PAPER_STIFFNESS_R2 if r2 is None else float(r2)
-    w = np.linspace(0.5e-3, 40e-3, 400) if widths is None else np.asarray(widths, dtype=float)
+    r1 = _core.PAPER_STIFFNESS_R1 if r1 is None else _real("r1 [m]", r1)
+    r2 = _core.PAPER_STIFFNESS_R2 if r2 is None else _real("r2 [m]", r2)
+    if widths is None:
+        w = np.linspace(0.5e-3, 40e-3, 400)
+    else:
+        try:
+            w = np.asarray(widths, dtype=float)
+        except (OverflowError, ValueError) as e:
+            raise ParameterError(
+                f"widths must be a 1-D array of contact widths [m], got {_short(widths)}"
+            ) from e
     if w.ndim != 1 or w.size < 2:
         raise ParameterError(
             f"widths must be a 1-D array of at least 2 contact widths [m], got shape {w.shape}"
         )
-    exponent = float(stiffness_kwargs.get("exponent", 1.5))
+    if isinstance(conditions, str):
+        conditions = (conditions,)
+    exponent = _real("exponent", stiffness_kwargs.get("exponent", 1.5))
     if ax is None:
         fig, ax = new_figure((7.5, 5.0))
     else:

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from . import _core
 from .errors import ParameterError, RvdynError
+from .plotting import _real, _whole, pin_indices
 
 __all__ = ["Result", "CHANNELS", "CHANNEL_SPECS"]
 
@@ -99,6 +100,11 @@ class Result:
     output_work: _Channel[np.float64] = _Channel()
     dissipated_energy: _Channel[np.float64] = _Channel()
     energy_residual: _Channel[np.float64] = _Channel()
+    pin_friction_power: _Channel[np.float64] = _Channel()
+    mesh_friction_power: _Channel[np.float64] = _Channel()
+    bearing_friction_power: _Channel[np.float64] = _Channel()
+    crank_bearing_force: _Channel[np.float64] = _Channel()
+    eccentric_bearing_force: _Channel[np.float64] = _Channel()
 
     def __init__(self, arrays: dict[str, NDArray[Any]], stats: dict[str, Any], scene: dict[str, Any] | None = None,
                  options: dict[str, Any] | None = None, error: RvdynError | None = None):
@@ -136,7 +142,14 @@ class Result:
     # ----------------------------------------------------------------- analysis
     def _steady_start(self, t_start: float | None) -> float:
         t = self.t
-        return float(t[-1] * 0.2 if t_start is None else t_start)
+        t0 = float(t[-1] * 0.2) if t_start is None else _real("t_start [s]", t_start)
+        if not (t[0] <= t0 < t[-1]):
+            raise ParameterError(f"t_start = {t0:.6g} s must lie inside the run [{t[0]:.6g}, {t[-1]:.6g}) s")
+        return t0
+
+    def _disc(self, disc: Any) -> int:
+        """A disc index checked against the recorded discs."""
+        return _whole("disc", disc, 0, int(self.disc_center.shape[1]) - 1)
 
     def steady_window(self, t_start: float | None = None) -> tuple[float, float]:
         """The largest window ``[t0, t_end]`` with ``t0 >= t_start`` spanning whole crank
@@ -145,8 +158,6 @@ class Result:
         t = self.t
         rel = self.crank_angle[:, 0] - self.carrier_angle
         t0 = self._steady_start(t_start)
-        if not (t[0] <= t0 < t[-1]):
-            raise ParameterError(f"t_start = {t0} s must lie inside the run [0, {t[-1]}) s")
         i0 = int(np.searchsorted(t, t0))
         span = abs(rel[-1] - rel[i0])
         turns = math.floor(span / (2 * math.pi))
@@ -198,8 +209,13 @@ class Result:
 
     def largest_moment_pin(self, time: float, disc: int = 0) -> int:
         """The paper's number (1-based) of the pin with the largest |moment| on ``disc`` at the
-        sample nearest ``time`` [s]."""
-        i = int(np.argmin(np.abs(self.t - time)))
+        sample nearest ``time`` [s] (inside the run)."""
+        t = self.t
+        time = _real("time [s]", time)
+        if not (t[0] <= time <= t[-1]):
+            raise ParameterError(f"time = {time:.6g} s must lie inside the run [{t[0]:.6g}, {t[-1]:.6g}] s")
+        disc = self._disc(disc)
+        i = int(np.argmin(np.abs(t - time)))
         return int(np.argmax(np.abs(self.pin_moment[i, disc]))) + 1
 
     def energy_balance(self) -> dict[str, float]:
@@ -213,6 +229,56 @@ class Result:
         scale = max(abs(w_in), abs(w_out), abs(diss), abs(change), 1e-300)
         return {"input_work": w_in, "output_work": w_out, "dissipated": diss, "energy_change": change,
                 "residual": res, "relative_residual": abs(res) / scale}
+
+    def efficiency(self, t_start: float | None = None) -> float:
+        """Efficiency output work / input work over the window from ``t_start`` [s] (default:
+        the steady part) to the end. Needs the ``"energy"`` channels."""
+        i0 = int(np.searchsorted(self.t, self._steady_start(t_start)))
+        w_in = float(self.input_work[-1] - self.input_work[i0])
+        w_out = float(self.output_work[-1] - self.output_work[i0])
+        if w_in == 0.0:
+            raise ParameterError("no input work in the window: efficiency undefined")
+        return w_out / w_in
+
+    def friction_power_means(self, t_start: float | None = None) -> dict[str, float]:
+        """Mean friction power [W] per family (pins, teeth, bearings) from ``t_start`` [s]."""
+        i0 = int(np.searchsorted(self.t, self._steady_start(t_start)))
+        return {name: float(np.mean(getattr(self, f"{name}_friction_power")[i0:]))
+                for name in ("pin", "mesh", "bearing")}
+
+    def bearing_life(self, t_start: float | None = None) -> dict[str, dict[str, float]]:
+        """Peak and equivalent radial load [N], ISO 281 rating [N] and basic rating life
+        ``L10`` [million revolutions and hours] of the most loaded eccentric and crank bearing,
+        from ``t_start`` [s] (default: the steady part). The equivalent load weights
+        ``|F|^(10/3)`` by the bearing's revolutions (relative rotation of its rings); the life
+        holds if the window repeats. Needs the ``"bearings"`` and ``"motion"`` channels and a
+        scene whose bearings are built from rollers (``rollers``)."""
+        c_ecc, c_crank = _core.CompiledScene.from_json(json.dumps(self.scene)).bearing_ratings()
+        i0 = int(np.searchsorted(self.t, self._steady_start(t_start)))
+        t = self.t[i0:]
+        duration = float(t[-1] - t[0])
+        out: dict[str, dict[str, float]] = {}
+        crank = self.crank_angle[i0:]
+        for name, rating, forces, rel in (
+            ("eccentric", c_ecc, self.eccentric_bearing_force[i0:],
+             crank[:, :, None] - self.disc_angle[i0:][:, None, :]),
+            ("crank", c_crank, self.crank_bearing_force[i0:], crank - self.carrier_angle[i0:][:, None]),
+        ):
+            if rating is None:
+                continue
+            mag = np.linalg.norm(forces, axis=-1)
+            rev = np.abs(np.diff(rel, axis=0)) / (2 * np.pi)
+            load = 0.5 * (mag[1:] + mag[:-1])
+            total = rev.sum(axis=0)
+            p_eq = (np.sum(load ** (10 / 3) * rev, axis=0) / np.where(total > 0, total, 1.0)) ** 0.3
+            worst = np.unravel_index(int(np.argmax(p_eq)), p_eq.shape)
+            p = float(p_eq[worst])
+            l10 = (rating / p) ** (10 / 3) if p > 0 else math.inf
+            rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
+            out[name] = {"peak_load": float(mag.max()), "equivalent_load": p, "rating": float(rating),
+                         "l10_million_revolutions": l10,
+                         "l10_hours": l10 * 1e6 / (60.0 * rpm) if rpm > 0 else math.inf}
+        return out
 
     # -------------------------------------------------------------------- files
     def save(self, path: str | Path) -> Path:
@@ -266,6 +332,7 @@ class Result:
         """Disc centre x and y vs time [mm] and its path, as the paper's Fig. 7."""
         import matplotlib.pyplot as plt
 
+        disc = self._disc(disc)
         if axes is None:
             _, axes = plt.subplots(1, 2, figsize=(11, 4))
         c = self.disc_center[:, disc] * 1e3
@@ -281,11 +348,16 @@ class Result:
                          window: tuple[float, float] | None = None, ax: Any = None) -> Any:
         """Moment of each pin's force about the disc centre [N m] vs time, for the paper's pin
         numbers ``pins`` (1-based), as the paper's Figs. 8-14, in ``window`` [s]."""
+        pins = list(pins)
+        index = pin_indices(pins, int(self.pin_moment.shape[2]))
+        disc = self._disc(disc)
+        if window is not None:
+            window = (_real("window start [s]", window[0]), _real("window end [s]", window[1]))
         ax = _axes(ax)
         t = self.t
         sel = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
-        for p in pins:
-            ax.plot(t[sel], self.pin_moment[sel, disc, p - 1], lw=0.8, label=f"pin {p}")
+        for p, j in zip(pins, index):
+            ax.plot(t[sel], self.pin_moment[sel, disc, j], lw=0.8, label=f"pin {p}")
         ax.set(xlabel="time [s]", ylabel=f"moment about disc {disc} centre [N m]")
         ax.legend(ncol=4, fontsize="small")
         return ax

@@ -78,7 +78,8 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     default 1e-5 s).
     record_interval: sample spacing [s] (default 1e-4 s), coarsened so that at most
     ``max_samples`` (default 50 000) samples are kept, which bounds memory on long runs.
-    channels: any of ``"motion"``, ``"pins"``, ``"contact_points"``, ``"mesh"``, ``"energy"``
+    channels: any of ``"motion"``, ``"pins"``, ``"contact_points"``, ``"mesh"``, ``"energy"``,
+    ``"bearings"``
     (default all but ``"contact_points"``); channels not asked for are not computed.
     progress: draw a progress bar on stderr (default: when stderr is a terminal).
     skip_separated: skip the exact gap query of pins that provably cannot touch (a Lipschitz

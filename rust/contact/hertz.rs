@@ -5,7 +5,7 @@
 //! Roark's Formulas for Stress and Strain (cylinder on cylinder); Harris, Rolling Bearing
 //! Analysis (Palmgren); see `notes/physics.md` section 3.
 
-use crate::error::{Result, RvdynError, require_non_negative, require_positive};
+use crate::error::{Result, RvdynError, num, require_non_negative, require_positive};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -47,8 +47,9 @@ impl Material {
         // Outside (-1, 0.5) the bulk or shear modulus is negative or infinite.
         if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {
             return Err(RvdynError::Parameter(format!(
-                "Poisson's ratio must be in (-1, 0.5) for a stable isotropic material, got {nu}; \
-                 steel is 0.3"
+                "Poisson's ratio must be in (-1, 0.5) for a stable isotropic material, got {}; \
+                 steel is 0.3",
+                num(nu)
             )));
         }
         Ok(())
@@ -81,7 +82,8 @@ pub fn effective_radius(r1: f64, r2: f64) -> Result<f64> {
         if !r.is_finite() || r == 0.0 {
             return Err(RvdynError::Geometry(format!(
                 "contact radius {name} must be finite and non-zero (positive convex, negative \
-                 concave), got {r} m"
+                 concave), got {} m",
+                num(r)
             )));
         }
     }
@@ -90,9 +92,13 @@ pub fn effective_radius(r1: f64, r2: f64) -> Result<f64> {
         Ok(1.0 / inv)
     } else {
         Err(RvdynError::Geometry(format!(
-            "radii r1 = {r1} m and r2 = {r2} m give 1/R = {inv} 1/m <= 0: the surfaces are \
-             concave-concave, conformal or nested and cannot touch as a Hertz line contact; \
-             a concave radius (negative) must be larger in magnitude than the convex one"
+            "radii r1 = {} m and r2 = {} m give 1/R = {} 1/m, not a finite positive number: the \
+             surfaces are concave-concave, conformal or nested and cannot touch as a Hertz line \
+             contact (a concave radius, negative, must be larger in magnitude than the convex \
+             one), or the radii are beyond the range of floating point",
+            num(r1),
+            num(r2),
+            num(inv)
         )))
     }
 }
@@ -149,16 +155,37 @@ pub fn hertz_line_contact(
     }
     let e_star = effective_modulus(m1, m2);
     let p = force / length;
-    let a = (4.0 * p * r / (PI * e_star)).sqrt();
-    let p0 = 2.0 * p / (PI * a);
-    let deflection =
-        |m: &Material, rk: f64| p * m.compliance() / PI * (2.0 * (4.0 * rk.abs() / a).ln() - 1.0);
-    Ok(LineContact {
+    // The closed forms rearranged so that no intermediate over- or underflows for any force
+    // whose results are representable: a = sqrt(P) sqrt(4R/(pi E*)),
+    // p0 = 2P/(pi a) = sqrt(P) sqrt(E*/(pi R)), ln(4|R_k|/a) = ln(4|R_k|) - ln(a) with
+    // ln(a) = (ln P + ln(4R/(pi E*)))/2 (P = 5e-324 N/m gives a ~ 1e-168 m, not 0).
+    let sqrt_p = p.sqrt();
+    let a = sqrt_p * (4.0 * r / (PI * e_star)).sqrt();
+    let p0 = sqrt_p * (e_star / (PI * r)).sqrt();
+    let ln_a = 0.5 * (p.ln() + (4.0 * r / (PI * e_star)).ln());
+    let deflection = |m: &Material, rk: f64| {
+        p * m.compliance() / PI * (2.0 * ((4.0 * rk.abs()).ln() - ln_a) - 1.0)
+    };
+    let c = LineContact {
         half_width: a,
         peak_pressure: p0,
         mean_pressure: 0.25 * PI * p0,
         approach: deflection(m1, r1) + deflection(m2, r2),
-    })
+    };
+    let values = [c.half_width, c.peak_pressure, c.mean_pressure, c.approach];
+    if !(values.iter().all(|v| v.is_finite()) && p.is_finite() && p > 0.0) {
+        return Err(RvdynError::Parameter(format!(
+            "the Hertz contact of force {} N over length {} m (radii {} m, {} m) is beyond the \
+             range of floating point (line load {} N/m): give a force and length of physical \
+             size",
+            num(force),
+            num(length),
+            num(r1),
+            num(r2),
+            num(p)
+        )));
+    }
+    Ok(c)
 }
 
 /// Palmgren's coefficient 3.84e-5 mm N^-0.9 mm^0.8 (steel roller against raceway).
@@ -301,6 +328,35 @@ mod tests {
                 c.peak_pressure
             );
         }
+    }
+
+    #[test]
+    fn extreme_forces_are_finite_or_errors() {
+        let m = Material::steel();
+        // The smallest force: the old form gave a = 0 and p0 = inf; the limits are a -> 0+,
+        // p0 -> 0+, approach -> 0.
+        let c = hertz_line_contact(5e-324, 0.04, 0.01, 0.1, &m, &m).unwrap();
+        assert!(c.half_width > 0.0 && c.half_width < 1e-150, "{c:?}");
+        assert!(c.peak_pressure > 0.0 && c.peak_pressure < 1e-140, "{c:?}");
+        assert!(c.approach.is_finite() && c.approach.abs() < 1e-300, "{c:?}");
+        // A line load beyond f64: an error naming the inputs, not inf/NaN.
+        let e = hertz_line_contact(1e308, 0.04, 0.01, 0.1, &m, &m).unwrap_err();
+        assert!(matches!(e, RvdynError::Parameter(_)), "{e}");
+        assert!(
+            e.to_string().contains("1e308") && e.to_string().len() < 400,
+            "{e}"
+        );
+        // The rearranged closed forms agree with the textbook ones at ordinary loads.
+        let c = hertz_line_contact(5e3, 0.04, 0.01, 0.1, &m, &m).unwrap();
+        let (p, r, es) = (
+            5e3 / 0.04,
+            1.0 / (1.0 / 0.01 + 1.0 / 0.1),
+            effective_modulus(&m, &m),
+        );
+        let a = (4.0 * p * r / (PI * es)).sqrt();
+        assert!(close(c.half_width, a, 1e-14) && close(c.peak_pressure, 2.0 * p / (PI * a), 1e-14));
+        let d = |rk: f64| p * m.compliance() / PI * (2.0 * (4.0 * rk / a).ln() - 1.0);
+        assert!(close(c.approach, d(0.01) + d(0.1), 1e-12), "{c:?}");
     }
 
     #[test]

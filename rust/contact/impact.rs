@@ -5,7 +5,7 @@
 //! is continuous at contact (a plain `c * xdot` would jump at impact). Sources: MSC ADAMS
 //! solver manual, IMPACT function; see `notes/physics.md` section 3.1.
 
-use crate::error::{Result, RvdynError, require_positive};
+use crate::error::{Result, RvdynError, num, require_positive};
 use serde::{Deserialize, Serialize};
 
 /// ADAMS STEP: cubic ramp from `h0` at `x0` to `h1` at `x1`, flat outside.
@@ -85,14 +85,14 @@ impl ImpactLaw {
                 "impact exponent must be a finite number >= 1, got {}: an exponent below 1 gives \
                  an infinite contact stiffness at zero penetration; use 1.5 for metal contacts \
                  (Hertz) or 1 for a linear spring",
-                self.exponent
+                num(self.exponent)
             )));
         }
         if !(self.max_damping.is_finite() && self.max_damping >= 0.0) {
             return Err(RvdynError::Parameter(format!(
                 "impact max_damping must be a finite number >= 0 N s/m, got {}; use 0 for an \
                  undamped contact",
-                self.max_damping
+                num(self.max_damping)
             )));
         }
         require_positive("impact damping_depth", self.damping_depth, "m")?;
@@ -135,6 +135,25 @@ impl ImpactLaw {
         let damping = step_cubic(penetration, 0.0, 0.0, self.damping_depth, self.max_damping);
         let f = self.stiffness * self.spring_power(penetration) + damping * penetration_rate;
         f.max(0.0)
+    }
+
+    /// [`ImpactLaw::force`] for values given by a user: the same force, or
+    /// `RvdynError::Parameter` if it is not finite (a penetration or rate so large that `k x^e`
+    /// or the damping term overflows), naming both inputs.
+    pub fn checked_force(&self, penetration: f64, penetration_rate: f64) -> Result<f64> {
+        let f = self.force(penetration, penetration_rate);
+        if f.is_finite() {
+            Ok(f)
+        } else {
+            Err(RvdynError::Parameter(format!(
+                "the IMPACT force overflows for penetration {} m and penetration rate {} m/s \
+                 (k = {} N/m^{}): give penetrations and rates of physical size",
+                num(penetration),
+                num(penetration_rate),
+                num(self.stiffness),
+                num(self.exponent)
+            )))
+        }
     }
 
     /// Elastic part of the force, `k x^e` [N] (0 without penetration).
@@ -307,6 +326,17 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn overflowing_forces_are_errors_not_infinity() {
+        let law = ImpactLaw::paper();
+        assert!(law.force(1e300, 0.0).is_infinite());
+        let e = law.checked_force(1e300, 0.0).unwrap_err().to_string();
+        assert!(e.contains("overflows") && e.contains("1e300"), "{e}");
+        assert!(law.checked_force(1e-5, 1e308).is_err());
+        assert_eq!(law.checked_force(1e-5, 0.1).unwrap(), law.force(1e-5, 0.1));
+        assert_eq!(law.checked_force(-1.0, 1e308).unwrap(), 0.0);
     }
 
     #[test]

@@ -36,7 +36,7 @@
 //! its curves cannot come from the printed formulas either).
 
 use crate::contact::hertz::Material;
-use crate::error::{Result, RvdynError, require_finite, require_positive};
+use crate::error::{Result, RvdynError, num, require_finite, require_positive};
 use std::f64::consts::PI;
 
 /// Millimetres per metre: the paper's formulas are evaluated in mm (see the module doc).
@@ -120,7 +120,8 @@ impl StiffnessParams {
                 "convex-concave contact needs the concave disc radius r2 = {} m to exceed the pin \
                  radius r1 = {} m (R = R1 R2/(R2 - R1) must be positive); use convex-convex or \
                  a larger r2",
-                self.r2, self.r1
+                num(self.r2),
+                num(self.r1)
             )));
         }
         self.material1.validate()?;
@@ -128,7 +129,7 @@ impl StiffnessParams {
         if !(self.exponent.is_finite() && self.exponent >= 1.0) {
             return Err(RvdynError::Parameter(format!(
                 "stiffness exponent must be a finite number >= 1, got {}; the paper uses 1.5",
-                self.exponent
+                num(self.exponent)
             )));
         }
         require_positive("penetration depth x", self.penetration, "m")?;
@@ -181,18 +182,40 @@ pub fn contact_stiffness_terms(width: f64, p: &StiffnessParams) -> Result<Stiffn
     let force = coefficient * x.powf(p.exponent);
     let k_d = 2.0 * r;
     let b = 1.60 * (force / length * k_d * c_e).sqrt();
-    let w = 2.0 * force / (PI * length)
-        * (c1 * (1.0 / 3.0 + (4.0 * r1 / b).ln()) + c2 * (1.0 / 3.0 + (4.0 * r2 / b).ln()));
-    if !(w.is_finite() && w > 0.0) {
+    let bracket = c1 * (1.0 / 3.0 + (4.0 * r1 / b).ln()) + c2 * (1.0 / 3.0 + (4.0 * r2 / b).ln());
+    let w = 2.0 * force / (PI * length) * bracket;
+    let stiffness_per_mm = coefficient * w.sqrt();
+    let out_of_range = || {
+        RvdynError::Parameter(format!(
+            "contact width {} m with radii r1 = {} m, r2 = {} m, exponent {} and penetration {} \
+             m is beyond the range of floating point for eqs. 5-11 (an intermediate over- or \
+             underflows); use values of physical size",
+            num(width),
+            num(p.r1),
+            num(p.r2),
+            num(p.exponent),
+            num(p.penetration)
+        ))
+    };
+    if b > 0.0 && bracket <= 0.0 {
         return Err(RvdynError::Parameter(format!(
-            "contact width {width} m is too small for eq. 9: the Hertz width b = {} m exceeds \
-             the radii so the deformation is {} m <= 0; use a width of at least a few \
-             micrometres",
-            b / MM_PER_M,
-            w / MM_PER_M
+            "contact width {} m is too small for eq. 9: the Hertz width b = {} m exceeds the \
+             radii so the deformation is {} m <= 0; use a width of at least a few micrometres",
+            num(width),
+            num(b / MM_PER_M),
+            num(w / MM_PER_M)
         )));
     }
-    let stiffness_per_mm = coefficient * w.sqrt();
+    let terms = [
+        coefficient,
+        force,
+        b,
+        w,
+        stiffness_per_mm * MM_PER_M.powf(p.exponent),
+    ];
+    if !(w > 0.0 && terms.iter().all(|v| v.is_finite())) {
+        return Err(out_of_range());
+    }
     Ok(StiffnessTerms {
         coefficient: coefficient * MM_PER_M.powf(1.5),
         force,
@@ -232,7 +255,9 @@ pub fn stiffness_maximum(p: &StiffnessParams, lo: f64, hi: f64) -> Result<(f64, 
     require_finite("upper width bound", hi)?;
     if hi <= lo {
         return Err(RvdynError::Parameter(format!(
-            "width bracket must satisfy lo < hi, got lo = {lo} m, hi = {hi} m"
+            "width bracket must satisfy lo < hi, got lo = {} m, hi = {} m",
+            num(lo),
+            num(hi)
         )));
     }
     let (ln_lo, ln_hi) = (lo.ln(), hi.ln());
@@ -252,11 +277,15 @@ pub fn stiffness_maximum(p: &StiffnessParams, lo: f64, hi: f64) -> Result<(f64, 
             ("upper", hi)
         };
         return Err(RvdynError::Parameter(format!(
-            "contact stiffness has no interior maximum for widths in [{lo}, {hi}] m: it is \
-             largest at the {end} end, width {width} m, k = {} N/m^{}; the corrected eqs. 5-11 \
+            "contact stiffness has no interior maximum for widths in [{}, {}] m: it is \
+             largest at the {end} end, width {} m, k = {} N/m^{}; the corrected eqs. 5-11 \
              decrease with width over physical widths (the paper's maximum near 5 mm is not \
              reproduced); widen the bracket to find the formal maximum",
-            best.1, p.exponent
+            num(lo),
+            num(hi),
+            num(width),
+            num(best.1),
+            num(p.exponent)
         )));
     }
     let (mut a, mut b) = (
@@ -459,5 +488,23 @@ mod tests {
         assert!(contact_stiffness_many(&[0.005, -1.0], &cc).is_err());
         assert!(stiffness_maximum(&cc, 0.01, 0.005).is_err());
         assert!(stiffness_maximum(&cc, 0.0, 0.005).is_err());
+    }
+
+    #[test]
+    fn extreme_widths_give_short_messages_that_say_why() {
+        let cc = StiffnessParams::paper(ContactCondition::ConvexConvex);
+        // The smallest width: too small, said in a short message (no 300-digit numbers).
+        let e = contact_stiffness(5e-324, &cc).unwrap_err().to_string();
+        assert!(
+            e.contains("too small") && e.contains("5e-324") && e.len() < 300,
+            "{e}"
+        );
+        // A huge width is not "too small": it is beyond floating point.
+        let e = stiffness_maximum(&cc, 1e-8, 1e308).unwrap_err().to_string();
+        assert!(
+            !e.contains("too small") && e.contains("floating point"),
+            "{e}"
+        );
+        assert!(e.len() < 400, "{e}");
     }
 }

@@ -11,10 +11,65 @@
 //! `phi = 0` is a tooth root (valley), `zc phi = pi` a lobe tip. The pins stay on the circle
 //! `rp` with radius `rrp`; the modifications only change the ground profile.
 
-use crate::error::{Result, RvdynError, require_finite, require_non_negative, require_positive};
+use crate::error::{
+    Result, RvdynError, num, require_finite, require_non_negative, require_positive,
+};
 use crate::geometry::profile_seed::ProfileSeed;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
+
+/// Most pins a disc may have. Real cycloid drives have about 10 to 100; the bound keeps the
+/// work and memory of a geometry (a polyline of 48 vertices per lobe, one state per pin in a
+/// run) finite for any accepted input.
+pub const MAX_PINS: u32 = 1000;
+
+/// Smallest length accepted for a size of the reducer [m] (1 nm).
+pub const MIN_LENGTH: f64 = 1e-9;
+
+/// Largest length accepted for a size of the reducer [m] (1 km). Between [`MIN_LENGTH`] and
+/// this, every formula of the geometry (up to fourth powers of lengths, for the polar moment of
+/// area) stays far inside the range of `f64`, so no result over- or underflows.
+pub const MAX_LENGTH: f64 = 1e3;
+
+/// `value` if it is a finite length in `[MIN_LENGTH, MAX_LENGTH]` [m], else
+/// `RvdynError::Parameter` naming it and the range.
+pub fn require_length(name: &str, value: f64) -> Result<f64> {
+    require_positive(name, value, "m")?;
+    if (MIN_LENGTH..=MAX_LENGTH).contains(&value) {
+        Ok(value)
+    } else {
+        Err(RvdynError::Parameter(format!(
+            "{name} = {} m is outside the supported range [{}, {}] m of reducer sizes",
+            num(value),
+            num(MIN_LENGTH),
+            num(MAX_LENGTH)
+        )))
+    }
+}
+
+/// Check the radius of every pin with its size error: `pin_radius + errors[j]` must be a
+/// length of at least [`MIN_LENGTH`] (a pin of zero or negative radius has no surface to
+/// touch). `errors` is empty (no errors) or one value per pin [m].
+///
+/// Errors (`RvdynError::Geometry`) name the first pin that breaks the rule, its error and
+/// the resulting radius.
+pub fn check_pin_radii(pin_radius: f64, errors: &[f64]) -> Result<()> {
+    for (j, &err) in errors.iter().enumerate() {
+        let r = pin_radius + err;
+        if !(r.is_finite() && r >= MIN_LENGTH) {
+            return Err(RvdynError::Geometry(format!(
+                "pin_errors.radius[{j}] = {} m makes pin {} (index {j}) {} m in radius \
+                 (pin_radius {} m + error); every pin radius must be > 0: use an error above {} m",
+                num(err),
+                j + 1,
+                num(r),
+                num(pin_radius),
+                num(-pin_radius)
+            )));
+        }
+    }
+    Ok(())
+}
 
 /// The parameters that define a cycloid disc and its pin ring (SI units).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -130,10 +185,17 @@ impl CycloidGeometry {
                 p.pins
             )));
         }
-        require_positive("eccentricity", p.eccentricity, "m")?;
-        require_positive("pin_circle_radius", p.pin_circle_radius, "m")?;
-        require_positive("pin_radius", p.pin_radius, "m")?;
-        require_positive("face_width", p.face_width, "m")?;
+        if p.pins > MAX_PINS {
+            return Err(RvdynError::Geometry(format!(
+                "at most {MAX_PINS} pins are supported, got {} (real cycloid drives have about \
+                 10 to 100)",
+                p.pins
+            )));
+        }
+        require_length("eccentricity", p.eccentricity)?;
+        require_length("pin_circle_radius", p.pin_circle_radius)?;
+        require_length("pin_radius", p.pin_radius)?;
+        require_length("face_width", p.face_width)?;
         require_finite("d_rp", p.d_rp)?;
         require_finite("d_rrp", p.d_rrp)?;
         require_finite("d_delta", p.d_delta)?;
@@ -141,14 +203,14 @@ impl CycloidGeometry {
         let zc = zp - 1.0;
         let gen_radius = p.pin_circle_radius + p.d_rp;
         let gen_pin_radius = p.pin_radius + p.d_rrp;
-        require_positive("pin_circle_radius + d_rp", gen_radius, "m")?;
-        require_positive("pin_radius + d_rrp", gen_pin_radius, "m")?;
+        require_length("pin_circle_radius + d_rp", gen_radius)?;
+        require_length("pin_radius + d_rrp", gen_pin_radius)?;
         let k1 = p.eccentricity * zp / gen_radius;
         if k1 >= 1.0 {
             return Err(RvdynError::Geometry(format!(
                 "curtate ratio K1 = e*zp/(rp+d_rp) = {k1:.4} must be < 1 (the pin-centre curve \
-                 loops otherwise): reduce the eccentricity below {:.6e} m or enlarge the pin circle",
-                gen_radius / zp
+                 loops otherwise): reduce the eccentricity below {} m or enlarge the pin circle",
+                num(gen_radius / zp)
             )));
         }
         let spacing = p.pin_circle_radius * (PI / zp).sin();
@@ -454,6 +516,86 @@ pub(crate) mod tests {
         }
         let n0 = g.normal(0.0);
         assert!(n0[0] > 0.99);
+    }
+
+    #[test]
+    fn counts_and_sizes_are_bounded() {
+        // 10**8 pins with nanometre sizes passed every rule and then aborted the process
+        // allocating the seed polyline (48 vertices per lobe).
+        let mut p = paper_params();
+        p.pins = 100_000_000;
+        p.eccentricity = 1e-9;
+        p.pin_radius = 1e-9;
+        let e = CycloidGeometry::new(p).unwrap_err();
+        assert!(e.to_string().contains("at most 1000 pins"), "{e}");
+        p.pins = MAX_PINS;
+        assert!(CycloidGeometry::check(p).is_ok());
+        // Sizes at which profile, normal or curvature overflowed are rejected, naming the range.
+        for (e, rp, rrp, face) in [
+            (1e-303, 1e-300, 1e-302, 1e-300),
+            (4.5e157, 1.5e160, 1e159, 4e159),
+        ] {
+            let q = CycloidParams {
+                eccentricity: e,
+                pin_circle_radius: rp,
+                pin_radius: rrp,
+                face_width: face,
+                ..paper_params()
+            };
+            let err = CycloidGeometry::new(q).unwrap_err().to_string();
+            assert!(err.contains("outside the supported range"), "{err}");
+        }
+        let q = CycloidParams {
+            d_rp: 1e300,
+            ..paper_params()
+        };
+        assert!(matches!(
+            CycloidGeometry::new(q),
+            Err(RvdynError::Parameter(_))
+        ));
+    }
+
+    #[test]
+    fn every_output_is_finite_at_the_ends_of_the_size_range() {
+        for scale in [MIN_LENGTH * 1.5, 1.0, MAX_LENGTH / 1.5] {
+            for pins in [3, 24, MAX_PINS] {
+                let zp = f64::from(pins);
+                let rp = scale;
+                let q = CycloidParams {
+                    pins,
+                    eccentricity: 0.5 * rp / zp,
+                    pin_circle_radius: rp,
+                    pin_radius: (0.3 * rp * (PI / zp).sin()).max(MIN_LENGTH),
+                    face_width: scale,
+                    d_rp: 0.0,
+                    d_rrp: 0.0,
+                    d_delta: 0.0,
+                };
+                let Ok(g) = CycloidGeometry::new(q) else {
+                    continue;
+                };
+                for i in 0..50 {
+                    let phi = 0.37 * f64::from(i);
+                    let v = [
+                        g.profile_point(phi)[0],
+                        g.profile_point(phi)[1],
+                        g.normal(phi)[0],
+                        g.curvature_radius(phi),
+                    ];
+                    assert!(v.iter().all(|x| x.is_finite()), "{q:?} phi {phi}: {v:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn pin_radii_must_stay_positive() {
+        assert!(check_pin_radii(0.01, &[]).is_ok());
+        assert!(check_pin_radii(0.01, &[0.0, -0.005, 0.002]).is_ok());
+        let e = check_pin_radii(0.01, &[0.0, -0.01]).unwrap_err();
+        assert!(matches!(e, RvdynError::Geometry(_)), "{e}");
+        assert!(e.to_string().contains("pin_errors.radius[1]"), "{e}");
+        assert!(check_pin_radii(0.01, &[-0.02]).is_err());
     }
 
     #[test]

@@ -11,12 +11,33 @@
 //! one.) What can fail is spacing (neighbouring planets' tip circles overlap) and continuity
 //! of mesh (contact ratio below 1); both are checked.
 
-use crate::error::{Result, RvdynError, require_non_negative, require_positive};
+use crate::error::{Result, RvdynError, num, require_non_negative};
+use crate::geometry::cycloid::require_length;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// Smallest tooth count accepted: below it the involute hardly exists above the base circle.
 const MIN_TEETH: u32 = 5;
+
+/// Largest tooth count accepted (far above any gear of a reducer's first stage); keeps every
+/// radius `m z / 2` well inside the range of `f64`.
+pub const MAX_TEETH: u32 = 10_000;
+
+/// Most planets, and so most crankshafts, a reducer may have (RV reducers have 2 or 3); the
+/// bound keeps the per-crank work and memory of a run finite for any accepted input.
+pub const MAX_PLANETS: u32 = 64;
+
+/// Check a crankshaft count (`cranks` of a scene, with or without a first stage): between 1
+/// and [`MAX_PLANETS`]. Errors (`RvdynError::Geometry`) name the count and the range.
+pub fn check_crank_count(cranks: u32) -> Result<()> {
+    if (1..=MAX_PLANETS).contains(&cranks) {
+        Ok(())
+    } else {
+        Err(RvdynError::Geometry(format!(
+            "cranks must be from 1 to {MAX_PLANETS}, got {cranks} (RV reducers have 2 or 3)"
+        )))
+    }
+}
 
 /// A sun/planet involute stage (SI units).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -80,14 +101,14 @@ impl InvoluteStage {
     /// backlash. `Geometry`: fewer than 5 teeth, no planet, neighbouring planets whose tip
     /// circles overlap (`2 a sin(pi/planets) <= 2 r_a,planet`), contact ratio below 1.
     pub fn validate(&self) -> Result<()> {
-        require_positive("gear module", self.module, "m")?;
-        require_positive("gear face width", self.face_width, "m")?;
+        require_length("gear module", self.module)?;
+        require_length("gear face width", self.face_width)?;
         require_non_negative("gear backlash", self.backlash, "m")?;
         let alpha = self.pressure_angle;
         if !(alpha.is_finite() && alpha > 0.0 && alpha < PI / 4.0) {
             return Err(RvdynError::Parameter(format!(
                 "pressure angle must be in (0, 45) deg, got {} deg; 20 deg is standard",
-                alpha.to_degrees()
+                num(alpha.to_degrees())
             )));
         }
         if self.z_sun < MIN_TEETH || self.z_planet < MIN_TEETH {
@@ -95,6 +116,18 @@ impl InvoluteStage {
                 "gear tooth counts must be at least {MIN_TEETH}, got z_sun = {}, z_planet = {} \
                  (below about 17 teeth at 20 deg a generated gear is undercut)",
                 self.z_sun, self.z_planet
+            )));
+        }
+        if self.z_sun > MAX_TEETH || self.z_planet > MAX_TEETH {
+            return Err(RvdynError::Geometry(format!(
+                "gear tooth counts must be at most {MAX_TEETH}, got z_sun = {}, z_planet = {}",
+                self.z_sun, self.z_planet
+            )));
+        }
+        if self.planets > MAX_PLANETS {
+            return Err(RvdynError::Geometry(format!(
+                "at most {MAX_PLANETS} planets are supported, got {}",
+                self.planets
             )));
         }
         if self.planets < 1 {
@@ -316,6 +349,18 @@ mod tests {
         );
         let e = s.validate().unwrap_err();
         assert!(e.to_string().contains("contact ratio"), "{e}");
+    }
+
+    #[test]
+    fn counts_are_bounded() {
+        assert!(check_crank_count(0).is_err());
+        assert!(check_crank_count(3).is_ok());
+        let e = check_crank_count(u32::MAX).unwrap_err().to_string();
+        assert!(e.contains("from 1 to 64"), "{e}");
+        // 2**32 - 1 planets around a huge sun passed the spacing rule before.
+        assert!(InvoluteStage::new(u32::MAX, 5, u32::MAX, 3e-3, 0.35, 0.03).is_err());
+        assert!(InvoluteStage::new(18, 42, MAX_PLANETS + 1, 3e-3, 0.35, 0.03).is_err());
+        assert!(InvoluteStage::new(18, 42, 3, 1e300, 0.35, 0.03).is_err());
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Lossless operating point: speeds and torques from power, input speed and ratio
 //! (paper section 4.1, design.md erratum 3).
 
-use crate::error::{Result, RvdynError, require_finite};
+use crate::error::{Result, RvdynError, num, require_finite};
 
 /// The output torque printed in the paper, section 4.1 [N m].
 ///
@@ -40,19 +40,34 @@ pub fn operating_point(power: f64, input_speed: f64, ratio: f64) -> Result<Opera
     require_finite("transmission ratio", ratio)?;
     if input_speed == 0.0 || ratio == 0.0 {
         return Err(RvdynError::Parameter(format!(
-            "input speed ({input_speed} rad/s) and ratio ({ratio}) must be non-zero to turn a \
-             power into torques; give a running speed"
+            "input speed ({} rad/s) and ratio ({}) must be non-zero to turn a power into \
+             torques; give a running speed",
+            num(input_speed),
+            num(ratio)
         )));
     }
     let input_torque = power / input_speed;
-    Ok(OperatingPoint {
+    let op = OperatingPoint {
         power,
         input_speed,
         output_speed: input_speed / ratio,
         input_torque,
         output_torque: input_torque * ratio,
         ratio,
-    })
+    };
+    if ![op.output_speed, op.input_torque, op.output_torque]
+        .iter()
+        .all(|v| v.is_finite())
+    {
+        return Err(RvdynError::Parameter(format!(
+            "power {} W at input speed {} rad/s through ratio {} gives a torque or speed beyond \
+             the range of floating point: give values of physical size (a speed far from zero)",
+            num(power),
+            num(input_speed),
+            num(ratio)
+        )));
+    }
+    Ok(op)
 }
 
 #[cfg(test)]
@@ -88,6 +103,9 @@ mod tests {
         assert!(operating_point(1e3, 1.0, 0.0).is_err());
         assert!(operating_point(f64::NAN, 1.0, 57.0).is_err());
         assert!(operating_point(1e3, f64::INFINITY, 57.0).is_err());
+        // Finite inputs whose torque overflows: an error, not inf.
+        assert!(operating_point(1.0, 5e-324, 1.0).is_err());
+        assert!(operating_point(1e308, 1.0, 1e10).is_err());
         // Idle: zero power is a valid point with zero torques.
         let idle = operating_point(0.0, 10.0, 57.0).unwrap();
         assert_eq!((idle.input_torque, idle.output_torque), (0.0, 0.0));

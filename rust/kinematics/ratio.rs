@@ -7,7 +7,7 @@
 //! - the sun/planet mesh rolls: `r_s (w_s - w_c) = -r_p phi'`, so
 //!   `w_s = w_c (1 + pins z_planet / z_sun)` and `i = w_s / w_c = 1 + (z_planet/z_sun) pins`.
 
-use crate::error::{Result, RvdynError, require_finite};
+use crate::error::{Result, RvdynError, num, require_finite};
 
 /// Overall ratio `i = input speed / output speed = 1 + (z_planet / z_sun) * pins` (eq. 4) [-].
 ///
@@ -58,6 +58,13 @@ pub fn body_speeds(input_speed: f64, z_sun: u32, z_planet: u32, pins: u32) -> Re
     let carrier = input_speed / transmission_ratio(z_sun, z_planet, pins)?;
     let crank_relative = -f64::from(pins) * carrier;
     let crank_absolute = carrier + crank_relative;
+    if !(crank_relative.is_finite() && crank_absolute.is_finite()) {
+        return Err(RvdynError::Parameter(format!(
+            "input speed {} rad/s overflows the crank speed for z_sun = {z_sun}, z_planet = \
+             {z_planet}, pins = {pins}: give a speed of physical size",
+            num(input_speed)
+        )));
+    }
     Ok(BodySpeeds {
         sun: input_speed,
         crank_absolute,
@@ -91,6 +98,9 @@ mod tests {
         let e = transmission_ratio(18, 42, 2).unwrap_err();
         assert!(matches!(e, RvdynError::Geometry(_)) && e.to_string().contains("3 pins"));
         assert!(body_speeds(f64::NAN, 18, 42, 24).is_err());
+        // Finite input, overflowing crank speed (crank/carrier = pins): an error, not inf.
+        assert!(body_speeds(1e308, u32::MAX, 1, u32::MAX).is_err());
+        assert!(body_speeds(1e290, u32::MAX, 1, u32::MAX).is_ok());
     }
 
     #[test]

@@ -1,53 +1,15 @@
 //! Bindings of the contact core: the paper's contact stiffness, Hertz line contact, the IMPACT
 //! law. Array arguments broadcast together (numpy rules); scalar-only calls return floats.
 
-use super::{Broadcast, FloatArray, Input, output, python_type, with_context};
+use super::arrays::check_ndim;
+use super::{Broadcast, FloatArray, Input, Real, output, python_type};
 use crate::contact::hertz::{Material, hertz_line_contact as core_hertz};
 use crate::contact::impact::ImpactLaw;
 use crate::contact::stiffness::{
     ContactCondition, StiffnessParams, contact_stiffness as core_stiffness,
     stiffness_maximum as core_maximum,
 };
-use crate::error::RvdynError;
 use pyo3::prelude::*;
-
-/// Run `f` on every broadcast element with the GIL released; the first error is returned with
-/// the element's flat index when there is more than one element.
-fn map_broadcast<const N: usize>(
-    py: Python<'_>,
-    b: &Broadcast,
-    f: impl Fn(&Broadcast, usize) -> Result<[f64; N], RvdynError> + Send + Sync,
-) -> PyResult<Vec<[f64; N]>> {
-    let out = py.detach(|| {
-        let mut out = Vec::with_capacity(b.len);
-        for i in 0..b.len {
-            match f(b, i) {
-                Ok(v) => out.push(v),
-                Err(e) if b.len > 1 => {
-                    return Err(with_context(e, &format!("at flat index {i} of the inputs")));
-                }
-                Err(e) => return Err(e),
-            }
-        }
-        Ok(out)
-    })?;
-    Ok(out)
-}
-
-/// One output array per column of `rows`.
-fn columns<'py, const N: usize>(
-    py: Python<'py>,
-    shape: &[usize],
-    rows: Vec<[f64; N]>,
-) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let mut cols: Vec<Vec<f64>> = (0..N).map(|_| Vec::with_capacity(rows.len())).collect();
-    for row in rows {
-        for (c, v) in cols.iter_mut().zip(row) {
-            c.push(v);
-        }
-    }
-    cols.into_iter().map(|c| output(py, shape, c)).collect()
-}
 
 /// The paper's stiffness parameters for radii `r1`, `r2` [m], one condition and one material
 /// for both bodies. Validated by the core when used.
@@ -109,7 +71,10 @@ fn stiffness_params(
 /// GeometryError
 ///     Convex-concave contact with r2 <= r1.
 #[pyfunction]
-#[pyo3(signature = (width, r1, r2, condition="convex-convex", youngs_modulus=2.17e11, poisson_ratio=0.3, exponent=1.5, penetration=1e-5))]
+#[pyo3(
+    signature = (width, r1, r2, condition="convex-convex", youngs_modulus=Real(2.17e11), poisson_ratio=Real(0.3), exponent=Real(1.5), penetration=Real(1e-5)),
+    text_signature = "(width, r1, r2, condition=\"convex-convex\", youngs_modulus=2.17e11, poisson_ratio=0.3, exponent=1.5, penetration=1e-5)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn contact_stiffness<'py>(
     py: Python<'py>,
@@ -117,31 +82,27 @@ fn contact_stiffness<'py>(
     r1: FloatArray<'py>,
     r2: FloatArray<'py>,
     condition: &str,
-    youngs_modulus: f64,
-    poisson_ratio: f64,
-    exponent: f64,
-    penetration: f64,
+    youngs_modulus: Real,
+    poisson_ratio: Real,
+    exponent: Real,
+    penetration: Real,
 ) -> PyResult<Bound<'py, PyAny>> {
     let condition = ContactCondition::parse(condition)?;
-    let material = Material::new(youngs_modulus, poisson_ratio)?;
+    let material = Material::new(youngs_modulus.0, poisson_ratio.0)?;
     let b = Broadcast::new(vec![
         ("width", Input::finite("width", "m", &width)?),
         ("r1", Input::finite("r1", "m", &r1)?),
         ("r2", Input::finite("r2", "m", &r2)?),
     ])?;
-    let rows = map_broadcast::<1>(py, &b, |b, i| {
-        let p = stiffness_params(
-            b.get(1, i),
-            b.get(2, i),
-            condition,
-            material,
-            exponent,
-            penetration,
-        );
-        Ok([core_stiffness(b.get(0, i), &p)?])
+    check_ndim("the result of contact_stiffness", b.shape.len())?;
+    let (exponent, penetration) = (exponent.0, penetration.0);
+    let values = py.detach(|| {
+        b.map_rows::<1>("the contact stiffness", |x| {
+            let p = stiffness_params(x[1], x[2], condition, material, exponent, penetration);
+            Ok([core_stiffness(x[0], &p)?])
+        })
     })?;
-    let shape = b.shape.clone();
-    output(py, &shape, rows.into_iter().map(|[k]| k).collect())
+    output(py, &b.shape, values)
 }
 
 /// Largest contact stiffness of eqs. 5-11 over contact widths in [lo, hi].
@@ -172,24 +133,27 @@ fn contact_stiffness<'py>(
 /// ParameterError
 ///     Invalid inputs, or no interior maximum in [lo, hi] (the largest value is at an end).
 #[pyfunction]
-#[pyo3(signature = (r1, r2, condition="convex-convex", lo=1e-4, hi=0.1, youngs_modulus=2.17e11, poisson_ratio=0.3, exponent=1.5, penetration=1e-5))]
+#[pyo3(
+    signature = (r1, r2, condition="convex-convex", lo=Real(1e-4), hi=Real(0.1), youngs_modulus=Real(2.17e11), poisson_ratio=Real(0.3), exponent=Real(1.5), penetration=Real(1e-5)),
+    text_signature = "(r1, r2, condition=\"convex-convex\", lo=1e-4, hi=0.1, youngs_modulus=2.17e11, poisson_ratio=0.3, exponent=1.5, penetration=1e-5)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn stiffness_maximum(
     py: Python<'_>,
-    r1: f64,
-    r2: f64,
+    r1: Real,
+    r2: Real,
     condition: &str,
-    lo: f64,
-    hi: f64,
-    youngs_modulus: f64,
-    poisson_ratio: f64,
-    exponent: f64,
-    penetration: f64,
+    lo: Real,
+    hi: Real,
+    youngs_modulus: Real,
+    poisson_ratio: Real,
+    exponent: Real,
+    penetration: Real,
 ) -> PyResult<(f64, f64)> {
     let condition = ContactCondition::parse(condition)?;
-    let material = Material::new(youngs_modulus, poisson_ratio)?;
-    let p = stiffness_params(r1, r2, condition, material, exponent, penetration);
-    Ok(py.detach(|| core_maximum(&p, lo, hi))?)
+    let material = Material::new(youngs_modulus.0, poisson_ratio.0)?;
+    let p = stiffness_params(r1.0, r2.0, condition, material, exponent.0, penetration.0);
+    Ok(py.detach(|| core_maximum(&p, lo.0, hi.0))?)
 }
 
 /// Hertz contact of two parallel cylinders (line contact), element-wise.
@@ -227,29 +191,38 @@ fn stiffness_maximum(
 /// GeometryError
 ///     Radii that cannot make a Hertz contact (zero, concave-concave, conformal or nested).
 #[pyfunction]
-#[pyo3(signature = (force, width, r1, r2, youngs_modulus=2.17e11, poisson_ratio=0.3))]
+#[pyo3(
+    signature = (force, width, r1, r2, youngs_modulus=Real(2.17e11), poisson_ratio=Real(0.3)),
+    text_signature = "(force, width, r1, r2, youngs_modulus=2.17e11, poisson_ratio=0.3)"
+)]
 fn hertz_line_contact<'py>(
     py: Python<'py>,
     force: FloatArray<'py>,
     width: FloatArray<'py>,
     r1: FloatArray<'py>,
     r2: FloatArray<'py>,
-    youngs_modulus: f64,
-    poisson_ratio: f64,
+    youngs_modulus: Real,
+    poisson_ratio: Real,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let m = Material::new(youngs_modulus, poisson_ratio)?;
+    let m = Material::new(youngs_modulus.0, poisson_ratio.0)?;
     let b = Broadcast::new(vec![
         ("force", Input::finite("force", "N", &force)?),
         ("width", Input::finite("width", "m", &width)?),
         ("r1", Input::finite("r1", "m", &r1)?),
         ("r2", Input::finite("r2", "m", &r2)?),
     ])?;
-    let rows = map_broadcast::<4>(py, &b, |b, i| {
-        let c = core_hertz(b.get(0, i), b.get(1, i), b.get(2, i), b.get(3, i), &m, &m)?;
-        Ok([c.half_width, c.peak_pressure, c.mean_pressure, c.approach])
+    check_ndim("the result of hertz_line_contact", b.shape.len())?;
+    let columns = py.detach(|| {
+        b.map_columns::<4>("the Hertz contact", |x| {
+            let c = core_hertz(x[0], x[1], x[2], x[3], &m, &m)?;
+            Ok([c.half_width, c.peak_pressure, c.mean_pressure, c.approach])
+        })
     })?;
-    let cols = columns(py, &b.shape, rows)?;
-    python_type(py, "LineContact")?.call1(pyo3::types::PyTuple::new(py, cols)?)
+    let arrays = columns
+        .into_iter()
+        .map(|c| output(py, &b.shape, c))
+        .collect::<PyResult<Vec<_>>>()?;
+    python_type(py, "LineContact")?.call1(pyo3::types::PyTuple::new(py, arrays)?)
 }
 
 /// Force of the ADAMS IMPACT contact law, element-wise.
@@ -285,17 +258,20 @@ fn hertz_line_contact<'py>(
 ///     Non-finite inputs, k <= 0, exponent < 1, cmax < 0, depth <= 0, shapes that do not
 ///     broadcast.
 #[pyfunction]
-#[pyo3(signature = (penetration, velocity, k, exponent=1.5, cmax=1.0e5, depth=1.0e-5))]
+#[pyo3(
+    signature = (penetration, velocity, k, exponent=Real(1.5), cmax=Real(1.0e5), depth=Real(1.0e-5)),
+    text_signature = "(penetration, velocity, k, exponent=1.5, cmax=1.0e5, depth=1.0e-5)"
+)]
 fn impact_force<'py>(
     py: Python<'py>,
     penetration: FloatArray<'py>,
     velocity: FloatArray<'py>,
-    k: f64,
-    exponent: f64,
-    cmax: f64,
-    depth: f64,
+    k: Real,
+    exponent: Real,
+    cmax: Real,
+    depth: Real,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let law = ImpactLaw::new(k, exponent, cmax, depth)?;
+    let law = ImpactLaw::new(k.0, exponent.0, cmax.0, depth.0)?;
     let b = Broadcast::new(vec![
         (
             "penetration",
@@ -303,8 +279,10 @@ fn impact_force<'py>(
         ),
         ("velocity", Input::finite("velocity", "m/s", &velocity)?),
     ])?;
-    let rows = map_broadcast::<1>(py, &b, |b, i| Ok([law.force(b.get(0, i), b.get(1, i))]))?;
-    output(py, &b.shape, rows.into_iter().map(|[f]| f).collect())
+    check_ndim("the result of impact_force", b.shape.len())?;
+    let values = py
+        .detach(|| b.map_rows::<1>("the IMPACT force", |x| Ok([law.checked_force(x[0], x[1])?])))?;
+    output(py, &b.shape, values)
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -9,14 +9,21 @@
 //! | `Scene`        | `rvdyn.SceneError(RvdynError, ValueError)`         |
 //! | `Convergence`  | `rvdyn.ConvergenceError(RvdynError, ArithmeticError)` |
 //! | `Simulation`   | `rvdyn.SimulationError(RvdynError, RuntimeError)`  |
+//! | `Memory`       | `MemoryError`                                      |
 //! | `Interrupted`  | `KeyboardInterrupt`                                |
+//!
+//! Python errors raised while reading an argument (an integer too large for a count, a string
+//! that is not a number) become the matching rvdyn class with the original exception chained as
+//! `__cause__` ([`chained`]); a wrong argument type stays a `TypeError`, as in Python itself.
 //!
 //! The classes are looked up in `rvdyn.errors` when the error is raised; if that module cannot
 //! be imported (a broken install), the built-in base class is raised with the same message, so
 //! `except ValueError` still works.
 
 use crate::error::RvdynError;
-use pyo3::exceptions::{PyArithmeticError, PyKeyboardInterrupt, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyArithmeticError, PyKeyboardInterrupt, PyMemoryError, PyRuntimeError, PyValueError,
+};
 use pyo3::prelude::*;
 
 /// Name of the Python class in `rvdyn.errors` for a variant (`None` for `Interrupted`).
@@ -27,7 +34,7 @@ fn class_name(err: &RvdynError) -> Option<&'static str> {
         RvdynError::Scene(_) => Some("SceneError"),
         RvdynError::Convergence(_) => Some("ConvergenceError"),
         RvdynError::Simulation(_) => Some("SimulationError"),
-        RvdynError::Interrupted => None,
+        RvdynError::Memory(_) | RvdynError::Interrupted => None,
     }
 }
 
@@ -39,6 +46,7 @@ fn fallback(err: &RvdynError, message: String) -> PyErr {
         }
         RvdynError::Convergence(_) => PyArithmeticError::new_err(message),
         RvdynError::Simulation(_) => PyRuntimeError::new_err(message),
+        RvdynError::Memory(_) => PyMemoryError::new_err(message),
         RvdynError::Interrupted => PyKeyboardInterrupt::new_err(message),
     }
 }
@@ -47,7 +55,7 @@ fn fallback(err: &RvdynError, message: String) -> PyErr {
 pub(crate) fn to_pyerr(py: Python<'_>, err: RvdynError) -> PyErr {
     let message = err.to_string();
     let Some(name) = class_name(&err) else {
-        return PyKeyboardInterrupt::new_err(message);
+        return fallback(&err, message);
     };
     let built = py
         .import("rvdyn.errors")
@@ -78,6 +86,15 @@ pub(crate) fn with_context(err: RvdynError, context: &str) -> RvdynError {
         RvdynError::Scene(m) => RvdynError::Scene(format!("{m} ({context})")),
         RvdynError::Convergence(m) => RvdynError::Convergence(format!("{m} ({context})")),
         RvdynError::Simulation(m) => RvdynError::Simulation(format!("{m} ({context})")),
+        RvdynError::Memory(m) => RvdynError::Memory(format!("{m} ({context})")),
         RvdynError::Interrupted => RvdynError::Interrupted,
     }
+}
+
+/// `err` as a Python exception with `cause` (the Python error that revealed it) chained as
+/// its `__cause__`, so the user sees both.
+pub(crate) fn chained(py: Python<'_>, err: RvdynError, cause: PyErr) -> PyErr {
+    let e = to_pyerr(py, err);
+    e.set_cause(py, Some(cause));
+    e
 }

@@ -1,6 +1,11 @@
 //! Bindings of the geometry core: `CycloidGeometry` and `InvoluteStage`.
 
-use super::{FloatArray, Input, count, output, parameter_error, point2, python_type, vec2};
+use super::arrays::check_ndim;
+use super::{
+    Broadcast, FloatArray, Input, Real, Whole, count, output, parameter_error, point2, python_type,
+    vec2,
+};
+use crate::error::RvdynError;
 use crate::geometry::cycloid::CycloidParams;
 use crate::geometry::mass::{DiscHoles, STEEL_DENSITY, disc_mass_properties};
 use crate::geometry::{CycloidGeometry, InvoluteStage, PinGap};
@@ -61,31 +66,64 @@ impl PyCycloidGeometry {
     }
 
     /// Evaluate `f` (returning `N` values per angle) over an array of angles, GIL released.
+    /// The result's size and dimensions are checked before anything is allocated; a
+    /// non-finite value is an error naming `what`, never returned.
     fn map_angles<'py, const N: usize>(
         &self,
         py: Python<'py>,
+        what: &str,
         phi: &FloatArray<'py>,
-        f: impl Fn(&CycloidGeometry, f64) -> [f64; N] + Send + Sync,
+        f: impl Fn(&CycloidGeometry, f64) -> Result<[f64; N], RvdynError> + Send + Sync,
     ) -> PyResult<Bound<'py, PyAny>> {
         let input = Input::finite("phi", "rad", phi)?;
-        let g = &self.inner;
-        let values = py.detach(|| {
-            let mut out = Vec::with_capacity(input.values.len() * N);
-            for &p in &input.values {
-                out.extend_from_slice(&f(g, p));
-            }
-            out
-        });
-        let mut shape = input.shape;
+        let mut shape = input.shape.clone();
         if N > 1 {
             shape.push(N);
         }
+        check_ndim(&format!("the result of {what}"), shape.len())?;
+        let b = Broadcast::new(vec![("phi", input)])?;
+        let g = &self.inner;
+        let values = py.detach(|| b.map_rows::<N>(what, |x| f(g, x[0])))?;
         output(py, &shape, values)
     }
 }
 
+/// A radius of curvature, or a `GeometryError` where the profile is straight (the pin-centre
+/// curve has an inflection exactly at `phi`, e.g. the root of a disc with K1 = 1/zp): the
+/// radius is infinite there.
+fn finite_curvature_radius(radius: f64, phi: f64) -> Result<[f64; 1], RvdynError> {
+    if radius.is_finite() {
+        Ok([radius])
+    } else {
+        Err(RvdynError::Geometry(format!(
+            "the profile is straight at phi = {} rad (an inflection of the pin-centre curve, \
+             e.g. the root of a disc with K1 = 1/zp): its radius of curvature is infinite",
+            crate::error::num(phi)
+        )))
+    }
+}
+
 /// Pack a core gap result as `rvdyn.GapResult`.
+/// A non-finite field (inputs beyond what the formulas represent) is a `ParameterError`.
 fn gap_result<'py>(py: Python<'py>, g: &PinGap) -> PyResult<Bound<'py, PyAny>> {
+    let fields = [
+        g.gap,
+        g.point[0],
+        g.point[1],
+        g.normal[0],
+        g.normal[1],
+        g.phi,
+        g.curvature_radius,
+    ];
+    if !g.curvature_radius.is_finite() && fields[..6].iter().all(|v| v.is_finite()) {
+        finite_curvature_radius(g.curvature_radius, g.phi)?;
+    }
+    if fields.iter().any(|v| !v.is_finite()) {
+        return Err(parameter_error(
+            "the gap is not finite for these inputs: they are beyond the range the formulas \
+             can represent in floating point; use positions of physical size",
+        ));
+    }
     python_type(py, "GapResult")?.call1((
         g.gap,
         vec2(py, g.point),
@@ -98,28 +136,31 @@ fn gap_result<'py>(py: Python<'py>, g: &PinGap) -> PyResult<Bound<'py, PyAny>> {
 #[pymethods]
 impl PyCycloidGeometry {
     #[new]
-    #[pyo3(signature = (pins, eccentricity, pin_circle_radius, pin_radius, face_width, d_rp=0.0, d_rrp=0.0, d_delta=0.0))]
+    #[pyo3(
+        signature = (pins, eccentricity, pin_circle_radius, pin_radius, face_width, d_rp=Real(0.0), d_rrp=Real(0.0), d_delta=Real(0.0)),
+        text_signature = "(pins, eccentricity, pin_circle_radius, pin_radius, face_width, d_rp=0.0, d_rrp=0.0, d_delta=0.0)"
+    )]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        pins: i64,
-        eccentricity: f64,
-        pin_circle_radius: f64,
-        pin_radius: f64,
-        face_width: f64,
-        d_rp: f64,
-        d_rrp: f64,
-        d_delta: f64,
+        pins: Whole,
+        eccentricity: Real,
+        pin_circle_radius: Real,
+        pin_radius: Real,
+        face_width: Real,
+        d_rp: Real,
+        d_rrp: Real,
+        d_delta: Real,
     ) -> PyResult<Self> {
         let pins = count("pins", pins)?;
         let inner = CycloidGeometry::new(CycloidParams {
             pins,
-            eccentricity,
-            pin_circle_radius,
-            pin_radius,
-            face_width,
-            d_rp,
-            d_rrp,
-            d_delta,
+            eccentricity: eccentricity.0,
+            pin_circle_radius: pin_circle_radius.0,
+            pin_radius: pin_radius.0,
+            face_width: face_width.0,
+            d_rp: d_rp.0,
+            d_rrp: d_rrp.0,
+            d_delta: d_delta.0,
         })?;
         Ok(Self { inner })
     }
@@ -207,7 +248,7 @@ impl PyCycloidGeometry {
     /// numpy.ndarray, shape phi.shape + (2,)
     ///     (x, y) [m]; shape (2,) for a scalar phi, (n, 2) for n angles.
     fn profile<'py>(&self, py: Python<'py>, phi: FloatArray<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.map_angles::<2>(py, &phi, |g, p| g.profile_point(p))
+        self.map_angles::<2>(py, "profile", &phi, |g, p| Ok(g.profile_point(p)))
     }
 
     /// Outward unit normals of the profile, disc frame.
@@ -222,7 +263,7 @@ impl PyCycloidGeometry {
     /// numpy.ndarray, shape phi.shape + (2,)
     ///     Unit vectors (x, y) [-], pointing from the disc material to the pins.
     fn normal<'py>(&self, py: Python<'py>, phi: FloatArray<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.map_angles::<2>(py, &phi, |g, p| g.normal(p))
+        self.map_angles::<2>(py, "normal", &phi, |g, p| Ok(g.normal(p)))
     }
 
     /// Signed radius of curvature of the profile [m]: positive where convex (lobe flanks and
@@ -243,7 +284,9 @@ impl PyCycloidGeometry {
         py: Python<'py>,
         phi: FloatArray<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.map_angles::<1>(py, &phi, |g, p| [g.curvature_radius(p)])
+        self.map_angles::<1>(py, "curvature_radius", &phi, |g, p| {
+            finite_curvature_radius(g.curvature_radius(p), p)
+        })
     }
 
     /// Exact signed gap between one pin and the profile of this disc placed in the fixed frame.
@@ -278,14 +321,16 @@ impl PyCycloidGeometry {
         py: Python<'py>,
         pin_center: FloatArray<'py>,
         disc_center: FloatArray<'py>,
-        disc_angle: f64,
-        pin_radius: Option<f64>,
+        disc_angle: Real,
+        pin_radius: Option<Real>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let pin = point2("pin_center", "m", &pin_center)?;
         let centre = point2("disc_center", "m", &disc_center)?;
         let result = match pin_radius {
-            None => self.inner.gap(pin, centre, disc_angle)?,
-            Some(r) => self.inner.gap_with_pin_radius(pin, r, centre, disc_angle)?,
+            None => self.inner.gap(pin, centre, disc_angle.0)?,
+            Some(r) => self
+                .inner
+                .gap_with_pin_radius(pin, r.0, centre, disc_angle.0)?,
         };
         gap_result(py, &result)
     }
@@ -313,10 +358,10 @@ impl PyCycloidGeometry {
     fn classical_pin_forces<'py>(
         &self,
         py: Python<'py>,
-        disc_torque: f64,
-        crank_angle: f64,
+        disc_torque: Real,
+        crank_angle: Real,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let f = crate::analysis::classical_pin_forces(&self.inner, disc_torque, crank_angle)?;
+        let f = crate::analysis::classical_pin_forces(&self.inner, disc_torque.0, crank_angle.0)?;
         output(py, &[f.len()], f)
     }
 
@@ -325,9 +370,9 @@ impl PyCycloidGeometry {
     fn classical_levers<'py>(
         &self,
         py: Python<'py>,
-        crank_angle: f64,
+        crank_angle: Real,
     ) -> PyResult<Bound<'py, PyAny>> {
-        crate::error::require_finite("crank_angle", crank_angle)?;
+        let crank_angle = crate::error::require_finite("crank_angle", crank_angle.0)?;
         let l = crate::analysis::classical_levers(&self.inner, crank_angle);
         output(py, &[l.len()], l)
     }
@@ -344,10 +389,12 @@ impl PyCycloidGeometry {
     /// -------
     /// (numpy.ndarray of shape (2,), float)
     ///     Disc centre [m] and disc angle [rad].
-    fn kinematic_pose<'py>(&self, py: Python<'py>, psi: f64) -> PyResult<Bound<'py, PyTuple>> {
+    fn kinematic_pose<'py>(&self, py: Python<'py>, psi: Real) -> PyResult<Bound<'py, PyTuple>> {
+        let psi = psi.0;
         if !psi.is_finite() {
             return Err(parameter_error(format!(
-                "psi must be a finite crank angle [rad], got {psi}"
+                "psi must be a finite crank angle [rad], got {}",
+                crate::error::num(psi)
             )));
         }
         let e = self.inner.params().eccentricity;
@@ -376,9 +423,9 @@ impl PyCycloidGeometry {
     /// (float, float)
     ///     (mass [kg], inertia [kg m^2]).
     // The text signature spells out STEEL_DENSITY (tests/test_geometry.py checks they agree).
-    #[pyo3(signature = (density=STEEL_DENSITY), text_signature = "($self, density=7850.0)")]
-    fn mass_properties(&self, density: f64) -> PyResult<(f64, f64)> {
-        let mp = disc_mass_properties(&self.inner, &DiscHoles::paper(), density)?;
+    #[pyo3(signature = (density=Real(STEEL_DENSITY)), text_signature = "($self, density=7850.0)")]
+    fn mass_properties(&self, density: Real) -> PyResult<(f64, f64)> {
+        let mp = disc_mass_properties(&self.inner, &DiscHoles::paper(), density.0)?;
         Ok((mp.mass, mp.inertia))
     }
 
@@ -453,25 +500,28 @@ pub(crate) struct PyInvoluteStage {
 #[pymethods]
 impl PyInvoluteStage {
     #[new]
-    #[pyo3(signature = (z_sun, z_planet, planets, module, pressure_angle, face_width, backlash=0.0))]
+    #[pyo3(
+        signature = (z_sun, z_planet, planets, module, pressure_angle, face_width, backlash=Real(0.0)),
+        text_signature = "(z_sun, z_planet, planets, module, pressure_angle, face_width, backlash=0.0)"
+    )]
     fn new(
-        z_sun: i64,
-        z_planet: i64,
-        planets: i64,
-        module: f64,
-        pressure_angle: f64,
-        face_width: f64,
-        backlash: f64,
+        z_sun: Whole,
+        z_planet: Whole,
+        planets: Whole,
+        module: Real,
+        pressure_angle: Real,
+        face_width: Real,
+        backlash: Real,
     ) -> PyResult<Self> {
         let inner = InvoluteStage::new(
             count("z_sun", z_sun)?,
             count("z_planet", z_planet)?,
             count("planets", planets)?,
-            module,
-            pressure_angle,
-            face_width,
+            module.0,
+            pressure_angle.0,
+            face_width.0,
         )?
-        .with_backlash(backlash)?;
+        .with_backlash(backlash.0)?;
         Ok(Self { inner })
     }
 

@@ -1,6 +1,6 @@
 //! Bindings of the kinematics core: ratio, body speeds, operating point.
 
-use super::{count, python_type};
+use super::{Real, Whole, count, python_type};
 use crate::kinematics::{
     PAPER_PRINTED_OUTPUT_TORQUE, body_speeds as core_speeds, operating_point as core_point,
     transmission_ratio as core_ratio,
@@ -27,7 +27,7 @@ use pyo3::types::PyDict;
 /// GeometryError
 ///     A tooth count below 1 or fewer than 3 pins.
 #[pyfunction]
-fn transmission_ratio(z_sun: i64, z_planet: i64, pins: i64) -> PyResult<f64> {
+fn transmission_ratio(z_sun: Whole, z_planet: Whole, pins: Whole) -> PyResult<f64> {
     Ok(core_ratio(
         count("z_sun", z_sun)?,
         count("z_planet", z_planet)?,
@@ -59,16 +59,19 @@ fn transmission_ratio(z_sun: i64, z_planet: i64, pins: i64) -> PyResult<f64> {
 /// GeometryError
 ///     Invalid tooth or pin counts.
 #[pyfunction]
-#[pyo3(signature = (input_speed, z_sun=18, z_planet=42, pins=24))]
+#[pyo3(
+    signature = (input_speed, z_sun=Whole::from(18), z_planet=Whole::from(42), pins=Whole::from(24)),
+    text_signature = "(input_speed, z_sun=18, z_planet=42, pins=24)"
+)]
 fn body_speeds<'py>(
     py: Python<'py>,
-    input_speed: f64,
-    z_sun: i64,
-    z_planet: i64,
-    pins: i64,
+    input_speed: Real,
+    z_sun: Whole,
+    z_planet: Whole,
+    pins: Whole,
 ) -> PyResult<Bound<'py, PyDict>> {
     let s = core_speeds(
-        input_speed,
+        input_speed.0,
         count("z_sun", z_sun)?,
         count("z_planet", z_planet)?,
         count("pins", pins)?,
@@ -110,11 +113,11 @@ fn body_speeds<'py>(
 #[pyfunction]
 fn operating_point<'py>(
     py: Python<'py>,
-    power: f64,
-    input_speed: f64,
-    ratio: f64,
+    power: Real,
+    input_speed: Real,
+    ratio: Real,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let op = core_point(power, input_speed, ratio)?;
+    let op = core_point(power.0, input_speed.0, ratio.0)?;
     python_type(py, "OperatingPoint")?.call1((
         op.power,
         op.input_speed,

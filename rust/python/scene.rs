@@ -81,6 +81,53 @@ impl CompiledScene {
         Ok(Self::new(Scene::paper(load)?)?)
     }
 
+    /// The physical preset (docs/model.md#the-physical-preset): the paper's reducer with line
+    /// contact pins, ISO 6336 meshes, roller bearings and 5 % modal damping; `load` as for
+    /// `paper`.
+    #[staticmethod]
+    fn physical(load: &str) -> PyResult<Self> {
+        Ok(Self::new(Scene::physical(load)?)?)
+    }
+
+    /// ISO 281 basic dynamic load ratings [N] of the eccentric and the crank bearings that are
+    /// built from rollers (`None` for a linear bearing, rigid crank bearings or ideal joints).
+    fn bearing_ratings(&self) -> PyResult<(Option<f64>, Option<f64>)> {
+        use crate::dynamics::scene::Joints;
+        let rating = |b: Option<&crate::dynamics::scene::Bearing>| -> PyResult<Option<f64>> {
+            match b.and_then(|b| b.rollers) {
+                Some(r) => Ok(Some(r.load_rating()?)),
+                None => Ok(None),
+            }
+        };
+        match &self.scene.joints {
+            Joints::Rigid => Ok((None, None)),
+            Joints::Compliant {
+                eccentric_bearing,
+                crank_bearing,
+            } => Ok((
+                rating(Some(eccentric_bearing))?,
+                rating(crank_bearing.as_ref())?,
+            )),
+        }
+    }
+
+    /// The contact physics at the rated operating point, as JSON text: pin law, classical peak
+    /// pin force [N] and the law's approach there [m], mesh law, rated mesh force [N] and mean
+    /// mesh stiffness [N/m], damping in words (`analysis::pin_load_sharing::physics_summary`).
+    fn physics_summary(&self) -> PyResult<String> {
+        let p = crate::analysis::pin_load_sharing::physics_summary(&self.scene)?;
+        let v = serde_json::json!({
+            "pin_law": p.pin_law,
+            "peak_pin_force_N": p.peak_pin_force,
+            "pin_approach_m": p.pin_approach,
+            "mesh_law": p.mesh_law,
+            "mesh_force_N": p.mesh_force,
+            "mesh_stiffness_N_per_m": p.mesh_stiffness,
+            "damping": p.damping,
+        });
+        Ok(v.to_string())
+    }
+
     /// The scene as JSON text (pretty when `indent`).
     #[pyo3(signature = (indent = true))]
     fn to_json(&self, indent: bool) -> PyResult<String> {

@@ -32,7 +32,7 @@ fn set_option(o: &mut SimOptions, key: &str, value: &Bound<'_, PyAny>) -> PyResu
         value.extract::<f64>().map_err(|_| {
             crate::python::parameter_error(format!(
                 "{key} must be a number ({what}), got {}",
-                value.repr().map(|r| r.to_string()).unwrap_or_default()
+                super::arrays::short_repr(value, 40)
             ))
         })
     };
@@ -49,10 +49,17 @@ fn set_option(o: &mut SimOptions, key: &str, value: &Bound<'_, PyAny>) -> PyResu
         "rho_inf" => o.rho_inf = float("in [0, 1]")?,
         "record_interval" => o.record_interval = if none { None } else { Some(float("s")?) },
         "max_samples" => {
-            let n: i64 = value.extract().map_err(|_| {
-                crate::python::parameter_error("max_samples must be a whole number >= 2")
-            })?;
-            o.max_samples = usize::try_from(n).unwrap_or(0);
+            let too_many = |text: &str| {
+                crate::python::parameter_error(format!(
+                    "max_samples must be a whole number in 2..={:.0e}, got {text}",
+                    crate::dynamics::run::driver::MAX_SAMPLES as f64
+                ))
+            };
+            o.max_samples = match value.extract::<crate::python::Whole>() {
+                Ok(crate::python::Whole::Value(n)) => usize::try_from(n).unwrap_or(0),
+                Ok(crate::python::Whole::TooLarge(text, _)) => return Err(too_many(&text)),
+                Err(_) => return Err(too_many(&super::arrays::short_repr(value, 30))),
+            };
         }
         "channels" => {
             o.channels = if none {
@@ -535,7 +542,8 @@ fn sweep<'py>(
     let opt = options.for_run(t_end)?;
     if threads.is_some_and(|n| n > MAX_THREADS) {
         return Err(crate::python::parameter_error(format!(
-            "threads must be at most {MAX_THREADS} (None = one per core), got {threads:?}"
+            "threads must be at most {MAX_THREADS} (None = one per core), got {}",
+            threads.unwrap_or_default()
         )));
     }
     let scenes: Vec<Arc<Scene>> = scenes.iter().map(|s| s.scene.clone()).collect();

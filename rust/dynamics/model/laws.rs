@@ -78,19 +78,60 @@ pub struct BearingLoad {
 }
 
 /// The radial law of a bearing (docs/model.md#compliant-joint-model).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum BearingLaw {
     /// Linear spring-damper with an optional radial clearance: no force inside the clearance,
     /// `F = (k pen + c pen') n` (>= 0) beyond it.
     Linear(Bearing),
+    /// Roller bearing built from its rollers (`bearing::RollerBearing`, Palmgren per roller)
+    /// with per-roller stiffness-proportional damping `beta` [s].
+    Rollers {
+        /// The rollers and the clearance.
+        bearing: crate::bearing::RollerBearing,
+        /// Damping factor of each roller [s].
+        beta: f64,
+        /// The scene bearing: its `stiffness` and `damping` act in parallel (0 for none).
+        parallel: Bearing,
+    },
 }
 
 impl BearingLaw {
+    /// The law of a scene bearing. Errors as [`crate::bearing::RollerBearing::new`].
+    pub fn new(b: &Bearing) -> Result<Self> {
+        Ok(match &b.rollers {
+            None => BearingLaw::Linear(*b),
+            Some(r) => BearingLaw::Rollers {
+                bearing: r.bearing(b.clearance)?,
+                beta: r.beta(),
+                parallel: *b,
+            },
+        })
+    }
+
     /// The load for a deflection `d` [m] and its rate `dd` [m/s].
     #[inline]
     pub fn load(&self, d: [f64; 2], dd: [f64; 2]) -> BearingLoad {
         match self {
             BearingLaw::Linear(b) => linear_bearing(b, d, dd),
+            BearingLaw::Rollers {
+                bearing,
+                beta,
+                parallel,
+            } => {
+                let r = bearing.damped_force(d, dd, *beta);
+                let mut out = BearingLoad {
+                    force: r.force,
+                    dissipation: r.dissipation,
+                    energy: r.energy,
+                };
+                if parallel.stiffness > 0.0 || parallel.damping > 0.0 {
+                    let l = linear_bearing(parallel, d, dd);
+                    out.force = [out.force[0] + l.force[0], out.force[1] + l.force[1]];
+                    out.dissipation += l.dissipation;
+                    out.energy += l.energy;
+                }
+                out
+            }
         }
     }
 }

@@ -58,6 +58,8 @@ pub struct Observation {
     pub kinetic_energy: f64,
     /// Elastic energy of the contacts and bearings [J].
     pub potential_energy: f64,
+    /// Friction power [W] at the pins, the teeth and the bearings.
+    pub friction_power: [f64; 3],
 }
 
 /// A reducer model the driver can integrate and record.
@@ -170,6 +172,7 @@ mod tests {
                 stiffness: kb,
                 damping: cb,
                 clearance: 0.0,
+                rollers: None,
             },
             crank_bearing: None,
         };

@@ -1,11 +1,12 @@
 //! The parts of a reducer model shared by the rigid and the compliant model: discs, pins,
 //! first-stage meshes, force laws, mass properties, drive and load, built once from a scene.
 
+use crate::contact::friction::{CoulombFriction, ToothPath};
+use crate::contact::law::{MeshLaw, PinLaw};
 use crate::dynamics::model::Layout;
 use crate::dynamics::model::drive::DriveProfile;
-use crate::dynamics::model::laws::ContactLaw;
 use crate::dynamics::scene::{Initial, Load, Scene};
-use crate::error::Result;
+use crate::error::{Result, RvdynError};
 use crate::geometry::CycloidGeometry;
 use crate::geometry::mass::{DiscHoles, MassProperties, disc_mass_properties, solid_cylinder};
 
@@ -17,6 +18,9 @@ pub(crate) struct DiscModel {
     pub(crate) phase: f64,
     /// Disc angle offset from the carrier angle, `-phase / zc` [rad].
     pub(crate) angle_offset: f64,
+    /// Body depth of the disc for the line contact law [m]: pin circle radius minus pin
+    /// radius (about the distance from the disc centre to a contact).
+    pub(crate) body_depth: f64,
 }
 
 /// One fixed pin.
@@ -35,9 +39,18 @@ pub(crate) struct MeshModel {
     pub(crate) planet_base_radius: f64,
     /// Total backlash along the line of action [m].
     pub(crate) backlash: f64,
-    pub(crate) law: ContactLaw,
+    pub(crate) law: MeshLaw,
     pub(crate) count: usize,
+    /// Mesh phase of each planet, fraction of a base pitch (`gear::planet_mesh_phases`).
+    pub(crate) phases: [f64; MAX_PLANETS],
+    /// Base pitch [m].
+    pub(crate) base_pitch: f64,
+    /// Path of contact for tooth friction.
+    pub(crate) path: ToothPath,
 }
+
+/// Most planets a stage may have (a fixed array keeps `MeshModel` `Copy`).
+pub(crate) const MAX_PLANETS: usize = 16;
 
 /// Mass properties actually used by a model (computed or from the scene).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,7 +70,11 @@ pub struct Parts {
     /// The fixed pins.
     pub(crate) pins: Vec<PinModel>,
     /// Law of the pin / profile contacts.
-    pub(crate) pin_law: ContactLaw,
+    pub(crate) pin_law: PinLaw,
+    /// Pin friction (coefficient already multiplied by the rolling-pin lever ratio).
+    pub(crate) pin_friction: Option<CoulombFriction>,
+    /// Tooth friction of the sun/planet meshes.
+    pub(crate) mesh_friction: Option<CoulombFriction>,
     /// The first-stage meshes, if any.
     pub(crate) mesh: Option<MeshModel>,
     /// Number of crankshafts.
@@ -94,6 +111,7 @@ impl Parts {
                 geometry: CycloidGeometry::new(scene.disc_params(k))?,
                 phase: d.phase,
                 angle_offset: -d.phase / zc,
+                body_depth: cyc.pin_circle_radius - cyc.pin_radius,
             });
         }
         let pins = (0..zp)
@@ -116,15 +134,37 @@ impl Parts {
                 }
             })
             .collect();
-        let pin_law = ContactLaw::from_spec(&scene.contact.pin, cyc.face_width)?;
+        let pin_law = scene.contact.pin.pin_law(cyc.face_width)?;
         let mesh = match &scene.stage1 {
-            Some(s) => Some(MeshModel {
-                sun_base_radius: s.sun_base_radius(),
-                planet_base_radius: s.planet_base_radius(),
-                backlash: s.backlash,
-                law: ContactLaw::from_spec(&scene.contact.mesh, s.face_width)?,
-                count: s.planets as usize,
-            }),
+            Some(s) => {
+                let count = s.planets as usize;
+                if count > MAX_PLANETS {
+                    return Err(RvdynError::Scene(format!(
+                        "stage1.planets = {count} exceeds the model's limit of {MAX_PLANETS}"
+                    )));
+                }
+                let mut phases = [0.0; MAX_PLANETS];
+                let ph = crate::gear::planet_mesh_phases(s.z_sun, &s.planet_angles())?;
+                phases[..count].copy_from_slice(&ph);
+                let pb = crate::gear::iso6336::base_pitch(s.module, s.pressure_angle);
+                Some(MeshModel {
+                    sun_base_radius: s.sun_base_radius(),
+                    planet_base_radius: s.planet_base_radius(),
+                    backlash: s.backlash,
+                    law: scene.contact.mesh.mesh_law(s)?,
+                    count,
+                    phases,
+                    base_pitch: pb,
+                    path: ToothPath::new(
+                        s.sun_base_radius(),
+                        s.planet_base_radius(),
+                        s.planet_tip_radius(),
+                        s.pressure_angle,
+                        pb,
+                        s.contact_ratio(),
+                    ),
+                })
+            }
             None => None,
         };
         let crank_radius = scene.stage1.as_ref().map_or(0.09, |s| s.centre_distance());
@@ -133,6 +173,19 @@ impl Parts {
             discs,
             pins,
             pin_law,
+            pin_friction: (scene.friction.pin > 0.0)
+                .then(|| {
+                    CoulombFriction::new(
+                        scene.friction.pin * scene.friction.pin_rolling.unwrap_or(1.0),
+                        scene.friction.regularisation_speed,
+                    )
+                })
+                .transpose()?,
+            mesh_friction: (scene.friction.mesh > 0.0)
+                .then(|| {
+                    CoulombFriction::new(scene.friction.mesh, scene.friction.regularisation_speed)
+                })
+                .transpose()?,
             mesh,
             cranks: scene.cranks as usize,
             crank_radius,

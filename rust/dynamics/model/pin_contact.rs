@@ -58,6 +58,9 @@ pub(crate) struct PinContact {
     pub(crate) normal: [f64; 2],
     /// Contact point on the profile relative to the disc centre [m].
     pub(crate) arm: [f64; 2],
+    /// Curve parameter of the contact on the profile [rad] (for laws that need the local
+    /// curvature).
+    pub(crate) phi: f64,
 }
 
 impl PinContact {
@@ -130,6 +133,7 @@ pub(crate) fn pin_query(
         penetration: -gap,
         normal: [c * nl[0] - s * nl[1], s * nl[0] + c * nl[1]],
         arm: [c * pl[0] - s * pl[1], s * pl[0] + c * pl[1]],
+        phi: foot.phi,
     })
 }
 

@@ -12,6 +12,7 @@
 //! `Q = -F grad(delta)`. Prescribed coordinates are taken from the drive; the reaction
 //! `M_ii a_i - Q_i` on them is the input torque.
 
+use crate::contact::law::PinSite;
 pub(crate) use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::pin_contact::{
     DiscPose, SeparationBound, WarmStart, penetration_error, pin_query,
@@ -37,6 +38,9 @@ pub(crate) struct Forces {
     pub(crate) dissipation: f64,
     /// Elastic energy stored in the contacts [J] (only when asked for).
     pub(crate) potential: f64,
+    /// Friction power [W] (>= 0; part of `dissipation`) per family: pin/disc (or pin/housing
+    /// for rolling pins), sun/planet teeth, bearings.
+    pub(crate) friction: [f64; 3],
 }
 
 /// The rigid-joint reducer model: the shared [`Parts`] plus its coordinates.
@@ -218,13 +222,42 @@ impl RigidModel {
                 let lever_c = pc.lever();
                 let lever_a = o[0] * n[1] - o[1] * n[0];
                 let pen_rate = lever_c * vc + lever_a * va;
-                let f = self.pin_law.force(pen, pen_rate);
+                let site = PinSite {
+                    geometry: &d.geometry,
+                    phi: pc.phi,
+                    pin_radius: pin.radius,
+                    depth: d.body_depth,
+                };
+                let lf = self.pin_law.evaluate(pen, pen_rate, &site, want_energy)?;
+                let f = lf.force;
                 out.q[CARRIER] -= f * lever_c;
                 out.q[CRANK] -= f * lever_a;
-                out.dissipation += (f - self.pin_law.elastic_force(pen)) * pen_rate;
-                if want_energy {
-                    out.potential += self.pin_law.elastic_energy(pen);
+                // Sliding friction: the disc's material point at the contact moves at
+                // O' + th' z x arm (O' = alpha' z x O); the force ft t (t = z x n) on the disc
+                // has the virtual work ft (arm . n) on th_c and ft (O . n) on alpha.
+                if let Some(fr) = &self.pin_friction {
+                    let arm = pc.arm;
+                    let vx = [-o[1] * va - vc * arm[1], o[0] * va + vc * arm[0]];
+                    let vs = n[0] * vx[1] - n[1] * vx[0];
+                    let ft = fr.force(vs, f);
+                    out.q[CARRIER] += ft * (arm[0] * n[0] + arm[1] * n[1]);
+                    out.q[CRANK] += ft * (o[0] * n[0] + o[1] * n[1]);
+                    let p = -ft * vs;
+                    out.dissipation += p;
+                    out.friction[0] += p;
                 }
+                // Location term of a line law (its energy depends on the contact's place on
+                // the profile): dO/dalpha = z x O, dtheta/dth_c = 1.
+                if let Some(ls) = self
+                    .pin_law
+                    .location_slope(lf.elastic, &site, pin.centre, o, th)
+                {
+                    let (fo, m) = ls.forces();
+                    out.q[CARRIER] += m;
+                    out.q[CRANK] += fo[1] * o[0] - fo[0] * o[1];
+                }
+                out.dissipation += (f - lf.elastic) * pen_rate;
+                out.potential += lf.energy;
                 let point = [o[0] + pc.arm[0], o[1] + pc.arm[1]];
                 // Moment of the pin's force (-f n) on the disc about the disc centre.
                 sink.pin(k, j, f, pen, -f * lever_c, point, n);
@@ -234,26 +267,58 @@ impl RigidModel {
             let delta = m.sun_base_radius * (x[SUN] - x[CARRIER])
                 + m.planet_base_radius * (x[CRANK] - x[CARRIER]);
             let rate = m.sun_base_radius * (v[SUN] - vc) + m.planet_base_radius * (va - vc);
-            let (f, elastic, pen, pen_rate) = m.law.mesh(m.backlash, delta, rate);
-            if pen > 0.0 {
-                if check && (pen.is_nan() || pen >= self.max_penetration) {
-                    return Err(penetration_error(
-                        t,
-                        pen,
-                        self.max_penetration,
-                        "a sun/planet mesh",
-                    ));
-                }
-                let nf = m.count as f64;
-                out.q[CARRIER] += nf * f * (m.sun_base_radius + m.planet_base_radius);
-                out.q[CRANK] -= nf * f * m.planet_base_radius;
-                out.q[SUN] -= nf * f * m.sun_base_radius;
-                out.dissipation += nf * (f.abs() - elastic.abs()) * pen_rate;
-                if want_energy {
-                    out.potential += nf * m.law.elastic_energy(pen);
-                }
-            }
+            // Mesh position along the line of action (sun relative to the carrier).
+            let s0 = m.sun_base_radius * (x[SUN] - x[CARRIER]);
+            let half = 0.5 * m.backlash;
+            // Drive flank (delta > half) or coast flank (delta < -half): the same base
+            // circles, so in this torsional model the coast flank is the mirror image.
+            let (pen, pen_rate, sign) = if delta > half {
+                (delta - half, rate, 1.0)
+            } else if delta < -half {
+                (-delta - half, -rate, -1.0)
+            } else {
+                (0.0, 0.0, 0.0)
+            };
             for i in 0..m.count {
+                let mut f = 0.0;
+                if pen > 0.0 {
+                    if check && (pen.is_nan() || pen >= self.max_penetration) {
+                        return Err(penetration_error(
+                            t,
+                            pen,
+                            self.max_penetration,
+                            "a sun/planet mesh",
+                        ));
+                    }
+                    // The coast flank (sign -1) runs through its tooth pairs in the mirrored
+                    // order: its mesh position is -s.
+                    let s_flank = sign * (s0 + m.phases[i] * m.base_pitch);
+                    let (lf, dk) = m.law.evaluate(pen, pen_rate, s_flank, want_energy);
+                    f = sign * lf.force;
+                    out.q[CARRIER] += f * (m.sun_base_radius + m.planet_base_radius);
+                    out.q[CRANK] -= f * m.planet_base_radius;
+                    out.q[SUN] -= f * m.sun_base_radius;
+                    // A stiffness that varies with the mesh position s stores
+                    // V = k(s) pen^2 / 2; its s-derivative is a generalised force too
+                    // (ds/dth_s = r_bs, ds/dth_c = -r_bs), which keeps the energy balance
+                    // (Oh, Grosh & Barber 2005).
+                    let dv_ds = 0.5 * dk * pen * pen * sign;
+                    out.q[SUN] -= dv_ds * m.sun_base_radius;
+                    out.q[CARRIER] += dv_ds * m.sun_base_radius;
+                    out.dissipation += (lf.force - lf.elastic) * pen_rate;
+                    out.potential += lf.energy;
+                    // Tooth friction (mirrored on the coast flank like the mesh position).
+                    if let Some(fr) = &self.mesh_friction {
+                        let w1 = sign * (v[SUN] - vc);
+                        let w2 = sign * (va - vc);
+                        let (t1, t2, p) = m.path.torques(fr, lf.force, s_flank, w1, w2);
+                        out.q[SUN] += sign * t1;
+                        out.q[CRANK] += sign * t2;
+                        out.q[CARRIER] -= sign * (t1 + t2);
+                        out.dissipation += p;
+                        out.friction[1] += p;
+                    }
+                }
                 sink.mesh(i, f, delta);
             }
         }

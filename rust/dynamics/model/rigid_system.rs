@@ -132,6 +132,7 @@ impl ReducerModel for RigidSystem<'_> {
             input_torque,
             kinetic_energy: m.kinetic_energy(&xv),
             potential_energy: f.potential,
+            friction_power: f.friction,
         })
     }
 }

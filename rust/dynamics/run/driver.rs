@@ -11,6 +11,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Most samples a run may keep (each sample holds up to a few hundred values of 8 bytes).
 pub const MAX_SAMPLES: usize = 100_000_000;
+/// Most values (samples x values per sample, 8 bytes each: 8 GB) a run may record.
+pub const MAX_RECORDED_VALUES: usize = 1_000_000_000;
 /// Most steps a fixed-step run may take.
 pub const MAX_STEPS: f64 = 1e10;
 
@@ -319,8 +321,19 @@ pub fn run_with<M: ReducerModel>(
     let (q0, v0) = sys.initial_state();
     let mut st = State::new(sys, 0.0, q0, v0)?;
     let interval = opt.sample_interval();
-    let n_samples = (opt.t_end / interval + 1e-9).floor() as usize + 1;
+    // interval >= t_end / (max_samples - 1), so this is at most max_samples + 1: no overflow.
+    let n_samples = ((opt.t_end / interval + 1e-9).floor() as usize).saturating_add(1);
     let mut rec = Recorder::new(sys.layout(), &opt.channels, n_samples);
+    let per = rec.values_per_sample();
+    if n_samples.saturating_mul(per) > MAX_RECORDED_VALUES {
+        return Err(RvdynError::Parameter(format!(
+            "recording {n_samples} samples of {per} values would keep {:.3e} values, more than \
+             {MAX_RECORDED_VALUES:.0e} (8 GB): lower max_samples, raise record_interval or \
+             record fewer channels",
+            n_samples as f64 * per as f64
+        )));
+    }
+    rec.reserve(n_samples)?;
     let mut next_sample = 0usize;
     let record =
         |rec: &mut Recorder, s: &State| -> Result<()> { rec.sample(sys, s.t, &s.q, &s.v, s.work) };

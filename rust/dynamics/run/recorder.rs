@@ -17,18 +17,22 @@ pub enum Channel {
     ContactPoints,
     /// Mesh forces and deflections, input torque.
     Mesh,
-    /// Kinetic and elastic energy, input and output work, dissipation, balance residual.
+    /// Kinetic and elastic energy, input and output work, dissipation, balance residual;
+    /// friction power per family.
     Energy,
+    /// Bearing forces of the compliant joints.
+    Bearings,
 }
 
 impl Channel {
     /// Every channel group, in recording order.
-    pub const ALL: [Channel; 5] = [
+    pub const ALL: [Channel; 6] = [
         Channel::Motion,
         Channel::Pins,
         Channel::ContactPoints,
         Channel::Mesh,
         Channel::Energy,
+        Channel::Bearings,
     ];
 
     /// The name used in the API (`"motion"`, `"pins"`, `"contact_points"`, `"mesh"`, `"energy"`).
@@ -39,6 +43,7 @@ impl Channel {
             Channel::ContactPoints => "contact_points",
             Channel::Mesh => "mesh",
             Channel::Energy => "energy",
+            Channel::Bearings => "bearings",
         }
     }
 
@@ -50,10 +55,11 @@ impl Channel {
             "contact_points" => Channel::ContactPoints,
             "mesh" => Channel::Mesh,
             "energy" => Channel::Energy,
+            "bearings" => Channel::Bearings,
             _ => {
                 return Err(RvdynError::Parameter(format!(
                     "unknown channel {name:?}: choose from \"motion\", \"pins\", \
-                     \"contact_points\", \"mesh\", \"energy\""
+                     \"contact_points\", \"mesh\", \"energy\", \"bearings\""
                 )));
             }
         })
@@ -66,6 +72,7 @@ impl Channel {
             Channel::Pins,
             Channel::Mesh,
             Channel::Energy,
+            Channel::Bearings,
         ]
     }
 }
@@ -152,7 +159,7 @@ const fn spec(
     }
 }
 
-use Channel::{ContactPoints, Energy, Mesh, Motion, Pins};
+use Channel::{Bearings, ContactPoints, Energy, Mesh, Motion, Pins};
 
 /// Every recorded channel, in recording order.
 pub static CHANNELS: &[ChannelSpec] = &[
@@ -302,11 +309,47 @@ pub static CHANNELS: &[ChannelSpec] = &[
         "energy dissipated by contact and bearing damping",
     ),
     spec(
+        "pin_friction_power",
+        Some(Energy),
+        &[],
+        "W",
+        "friction power at the pins (pin/disc, or pin/housing for rolling pins)",
+    ),
+    spec(
+        "mesh_friction_power",
+        Some(Energy),
+        &[],
+        "W",
+        "friction power at the sun/planet teeth",
+    ),
+    spec(
+        "bearing_friction_power",
+        Some(Energy),
+        &[],
+        "W",
+        "friction power of the joint bearings (compliant joints)",
+    ),
+    spec(
         "energy_residual",
         Some(Energy),
         &[],
         "J",
         "E_kin + E_el - E0 - W_in + W_out + D (0 for an exact integration)",
+    ),
+    spec(
+        "crank_bearing_force",
+        Some(Bearings),
+        &[Dim::Cranks, Dim::Xy],
+        "N",
+        "force of crank bearing i on its crank centre, fixed frame (0 with rigid crank \
+         bearings or ideal joints)",
+    ),
+    spec(
+        "eccentric_bearing_force",
+        Some(Bearings),
+        &[Dim::Cranks, Dim::Discs, Dim::Xy],
+        "N",
+        "force of the eccentric bearing of crank i on disc k, fixed frame (0 with ideal joints)",
     ),
 ];
 
@@ -346,6 +389,9 @@ pub(crate) struct SampleSink {
     pub normal: Vec<f64>,
     pub mesh_force: Vec<f64>,
     pub mesh_deflection: Vec<f64>,
+    /// Crank bearing forces `(cranks, 2)` and eccentric bearing forces `(cranks, discs, 2)`.
+    pub crank_bearing: Vec<f64>,
+    pub eccentric_bearing: Vec<f64>,
 }
 
 impl ContactSink for SampleSink {
@@ -383,6 +429,16 @@ impl ContactSink for SampleSink {
         if let Some(f) = self.mesh_force.get_mut(i) {
             *f = force;
             self.mesh_deflection[i] = deflection;
+        }
+    }
+    fn bearing(&mut self, family: usize, index: usize, force: [f64; 2]) {
+        let v = if family == 0 {
+            &mut self.crank_bearing
+        } else {
+            &mut self.eccentric_bearing
+        };
+        if let Some(slot) = v.get_mut(2 * index..2 * index + 2) {
+            slot.copy_from_slice(&force);
         }
     }
 }
@@ -432,6 +488,8 @@ impl Recorder {
             normal: vec![0.0; 2 * nd * zp],
             mesh_force: vec![0.0; nm],
             mesh_deflection: vec![0.0; nm],
+            crank_bearing: vec![0.0; 2 * layout.cranks],
+            eccentric_bearing: vec![0.0; 2 * layout.cranks * nd],
         };
         Self {
             channels: channels.to_vec(),
@@ -445,6 +503,34 @@ impl Recorder {
             nd,
             initial_energy: None,
         }
+    }
+
+    /// Values recorded per sample over all series.
+    pub fn values_per_sample(&self) -> usize {
+        self.rec
+            .series
+            .values()
+            .map(|s| s.sample_shape.iter().product::<usize>())
+            .sum()
+    }
+
+    /// Reserve room for `samples` samples in every series without the aborting allocation
+    /// path: `RvdynError::Memory` if the memory cannot be had.
+    pub fn reserve(&mut self, samples: usize) -> Result<()> {
+        for (name, s) in self.rec.series.iter_mut() {
+            let per: usize = s.sample_shape.iter().product();
+            let n = samples.saturating_mul(per);
+            let extra = n.saturating_sub(s.data.len());
+            if s.data.try_reserve_exact(extra).is_err() {
+                return Err(RvdynError::Memory(format!(
+                    "cannot allocate channel {name}: {samples} samples of {per} values \
+                     ({:.3e} bytes); record fewer samples (max_samples, record_interval) or \
+                     fewer channels",
+                    n as f64 * 8.0
+                )));
+            }
+        }
+        Ok(())
     }
 
     fn push(&mut self, name: &'static str, values: &[f64]) {
@@ -521,7 +607,18 @@ impl Recorder {
             self.push("input_work", &[work[0]]);
             self.push("output_work", &[work[1]]);
             self.push("dissipated_energy", &[work[2]]);
+            self.push("pin_friction_power", &[obs.friction_power[0]]);
+            self.push("mesh_friction_power", &[obs.friction_power[1]]);
+            self.push("bearing_friction_power", &[obs.friction_power[2]]);
             self.push("energy_residual", &[residual]);
+        }
+        if has(Channel::Bearings) {
+            let (cb, eb) = (
+                self.sink.crank_bearing.clone(),
+                self.sink.eccentric_bearing.clone(),
+            );
+            self.push("crank_bearing_force", &cb);
+            self.push("eccentric_bearing_force", &eb);
         }
         self.rec.samples += 1;
         Ok(())

@@ -34,6 +34,9 @@ pub trait ContactSink {
     }
     /// Mesh `i`: force along the line of action [N] (negative on the coast flank), deflection [m].
     fn mesh(&mut self, _i: usize, _force: f64, _deflection: f64) {}
+    /// Bearing force [N] (fixed frame): `family` 0 = crank bearing `index` (force on the crank
+    /// centre), 1 = eccentric bearing `index = crank * discs + disc` (force on the disc).
+    fn bearing(&mut self, _family: usize, _index: usize, _force: [f64; 2]) {}
 }
 
 /// The sink of the hot path: ignores everything.
@@ -67,5 +70,8 @@ impl ContactSink for DynSink<'_> {
     }
     fn mesh(&mut self, i: usize, force: f64, deflection: f64) {
         self.0.mesh(i, force, deflection);
+    }
+    fn bearing(&mut self, family: usize, index: usize, force: [f64; 2]) {
+        self.0.bearing(family, index, force);
     }
 }

@@ -10,9 +10,13 @@ mod validate;
 
 pub use paths::get_path;
 pub(crate) use paths::{set_path, unknown_fields};
-pub use presets::{PAPER_INPUT_SPEED, PAPER_POWER, PAPER_PRINTED_LOAD};
+pub use presets::{
+    PAPER_INPUT_SPEED, PAPER_POWER, PAPER_PRINTED_LOAD, PHYSICAL_DAMPING_RATIO,
+    PHYSICAL_REFERENCE_FREQUENCY, physical_joints,
+};
 
 use crate::contact::ImpactLaw;
+use crate::contact::law::{ContactDamping, DampingSpec, IsoMesh, MeshLaw, PinLaw, scene_material};
 use crate::error::{Result, RvdynError};
 use crate::geometry::cycloid::CycloidParams;
 use crate::geometry::involute::InvoluteStage;
@@ -49,6 +53,71 @@ pub struct PinErrors {
     pub radius: Vec<f64>,
 }
 
+/// Manufacturing and assembly errors of the cranks, discs and carrier (SI; compliant joints
+/// only: with ideal joints they would over-constrain the discs). Empty lists mean no error.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AssemblyErrors {
+    /// Eccentricity error of each crank [m] (`e -> e + de_i`, both eccentrics of the crank).
+    #[serde(default)]
+    pub crank_eccentricity: Vec<f64>,
+    /// Phase error of each crank's eccentrics [rad].
+    #[serde(default)]
+    pub crank_phase: Vec<f64>,
+    /// Position error of each crank hole in each disc, `[crank][disc]` flattened as
+    /// `crank * discs + disc`, (dx, dy) in the disc frame [m].
+    #[serde(default)]
+    pub disc_holes: Vec<[f64; 2]>,
+    /// Position error of each crank seat in the carrier, (dx, dy) in the carrier frame [m].
+    #[serde(default)]
+    pub carrier_seats: Vec<[f64; 2]>,
+}
+
+impl AssemblyErrors {
+    /// Whether any error is given.
+    pub fn any(&self) -> bool {
+        !(self.crank_eccentricity.is_empty()
+            && self.crank_phase.is_empty()
+            && self.disc_holes.is_empty()
+            && self.carrier_seats.is_empty())
+    }
+
+    /// Check lengths (`cranks`, `cranks * discs`), finiteness, and that an eccentricity error
+    /// stays below the eccentricity `e` [m] in magnitude.
+    pub fn check(&self, cranks: usize, discs: usize, e: f64) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Scene(m));
+        for (n, len, want) in [
+            ("crank_eccentricity", self.crank_eccentricity.len(), cranks),
+            ("crank_phase", self.crank_phase.len(), cranks),
+            ("disc_holes", self.disc_holes.len(), cranks * discs),
+            ("carrier_seats", self.carrier_seats.len(), cranks),
+        ] {
+            if len != 0 && len != want {
+                return bad(format!(
+                    "errors.{n} must be empty or have {want} entries, got {len}"
+                ));
+            }
+        }
+        let finite = self
+            .crank_eccentricity
+            .iter()
+            .chain(&self.crank_phase)
+            .chain(self.disc_holes.iter().flatten())
+            .chain(self.carrier_seats.iter().flatten())
+            .all(|v| v.is_finite());
+        if !finite {
+            return bad("errors must be finite numbers (m, rad)".into());
+        }
+        if let Some(de) = self.crank_eccentricity.iter().find(|d| d.abs() >= e) {
+            return bad(format!(
+                "errors.crank_eccentricity {de} m must be smaller in magnitude than the \
+                 eccentricity {e} m"
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Mass properties of the bodies; `None` = computed from the geometry (steel).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -70,17 +139,103 @@ pub struct Inertias {
     pub load_inertia: f64,
 }
 
-/// A bearing spring-damper (compliant joints).
+/// A bearing spring-damper (compliant joints): linear (`stiffness`, `damping`), or built from
+/// its rollers (`rollers`), with `stiffness` and `damping` then a linear spring-damper in
+/// parallel (0 for none; same clearance).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Bearing {
-    /// Radial stiffness [N/m].
+    /// Radial stiffness [N/m] (with rollers: a parallel linear spring, 0 for none).
     pub stiffness: f64,
-    /// Radial damping [N s/m].
+    /// Radial damping [N s/m] (with rollers: a parallel damper, 0 for none).
     pub damping: f64,
-    /// Radial clearance [m].
+    /// Radial clearance per side [m].
     #[serde(default)]
     pub clearance: f64,
+    /// Roller (needle) bearing: nonlinear load-deflection from its rollers (Palmgren line
+    /// contact per roller at both raceways; `bearing::roller`).
+    #[serde(default)]
+    pub rollers: Option<Rollers>,
+}
+
+/// The rollers of a roller bearing (SI).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Rollers {
+    /// Number of rollers (at least 3).
+    pub count: u32,
+    /// Effective roller length [m].
+    pub length: f64,
+    /// Roller diameter [m] (for the ISO 281 load rating).
+    pub diameter: f64,
+    /// Pitch diameter of the roller set [m] (for the load rating).
+    pub pitch_diameter: f64,
+    /// Damping ratio [-] of the stiffness-proportional roller damping, referred to
+    /// `frequency`: each roller pushes with `max(0, Q + beta k delta')`,
+    /// `beta = 2 damping_ratio / (2 pi frequency)`.
+    pub damping_ratio: f64,
+    /// Reference frequency of the damping ratio [Hz].
+    pub frequency: f64,
+}
+
+impl Rollers {
+    /// The roller load-deflection law with the bearing's clearance [m].
+    pub fn bearing(&self, clearance: f64) -> Result<crate::bearing::RollerBearing> {
+        crate::bearing::RollerBearing::new(self.count as usize, self.length, clearance)
+    }
+
+    /// `beta` [s] of the roller damping.
+    pub fn beta(&self) -> f64 {
+        2.0 * self.damping_ratio / (std::f64::consts::TAU * self.frequency)
+    }
+
+    /// ISO 281 basic dynamic load rating [N] (one row, `b_m = 1.1`).
+    pub fn load_rating(&self) -> Result<f64> {
+        crate::bearing::RollerBearingGeometry {
+            rollers: self.count,
+            rows: 1,
+            roller_diameter: self.diameter,
+            roller_length: self.length,
+            pitch_diameter: self.pitch_diameter,
+            contact_angle: 0.0,
+            rating_factor: crate::bearing::life::BM_ROLLER,
+        }
+        .dynamic_load_rating()
+    }
+
+    /// Check the fields, naming `at` (e.g. `"joints.eccentric_bearing"`) in the message.
+    pub fn check(&self, at: &str) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Scene(format!("{at}.rollers: {m}")));
+        if self.count < 3 {
+            return bad(format!(
+                "count must be at least 3 rollers, got {}",
+                self.count
+            ));
+        }
+        for (n, v) in [
+            ("length", self.length),
+            ("diameter", self.diameter),
+            ("pitch_diameter", self.pitch_diameter),
+            ("frequency", self.frequency),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(format!("{n} must be > 0, got {v}"));
+            }
+        }
+        if self.diameter >= self.pitch_diameter {
+            return bad(format!(
+                "diameter {} m must be below pitch_diameter {} m",
+                self.diameter, self.pitch_diameter
+            ));
+        }
+        if !(self.damping_ratio.is_finite() && (0.0..1.0).contains(&self.damping_ratio)) {
+            return bad(format!(
+                "damping_ratio must be in [0, 1), got {}",
+                self.damping_ratio
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Crank-eccentric/disc and crank/carrier bearings.
@@ -127,6 +282,32 @@ pub enum ContactLawSpec {
         /// Penetration at which the full damping acts [m].
         damping_depth: f64,
     },
+    /// Pins only: line contact of the pin and the local profile curvature (Johnson; see
+    /// `contact::line_contact`), materials of pin and disc, and a damping law.
+    Line {
+        /// Young's modulus of pins and discs [Pa] (default the paper's 2.17e11).
+        #[serde(default = "crate::contact::law::default_youngs_modulus")]
+        youngs_modulus: f64,
+        /// Poisson's ratio [-] (default 0.3).
+        #[serde(default = "crate::contact::law::default_poisson_ratio")]
+        poisson_ratio: f64,
+        /// Damping of the contacts.
+        damping: DampingSpec,
+    },
+    /// Meshes only: ISO 6336-1 method B stiffness, varying along the line of action with the
+    /// single- and double-tooth zones (`gear::iso6336`), and a damping law.
+    Iso6336 {
+        /// Width of the smoothing ramps at the zone boundaries, fraction of a base pitch
+        /// (default 0.02; 0 for jumps).
+        #[serde(default = "default_mesh_ramp")]
+        ramp: f64,
+        /// Damping of the meshes.
+        damping: DampingSpec,
+    },
+}
+
+fn default_mesh_ramp() -> f64 {
+    0.02
 }
 
 impl ContactLawSpec {
@@ -142,7 +323,9 @@ impl ContactLawSpec {
         }
     }
 
-    /// The force law for a contact of length `face_width` [m].
+    /// The IMPACT-type law for a contact of length `face_width` [m] (`impact` and `palmgren`).
+    ///
+    /// Errors (`Scene`) for `line` and `iso6336`, which are not IMPACT laws.
     pub fn law(&self, face_width: f64) -> Result<ImpactLaw> {
         match *self {
             ContactLawSpec::Impact {
@@ -160,6 +343,64 @@ impl ContactLawSpec {
                 let k = (1e3 * l_mm.powf(0.8) / 3.84e-5).powf(1.0 / 0.9);
                 ImpactLaw::new(k, 1.0 / 0.9, max_damping, damping_depth)
             }
+            ContactLawSpec::Line { .. } | ContactLawSpec::Iso6336 { .. } => Err(RvdynError::Scene(
+                "this contact law is not an IMPACT-type law (line and iso6336 are built \
+                     from the geometry)"
+                    .into(),
+            )),
+        }
+    }
+
+    /// The pin/disc law for discs of face width `face_width` [m].
+    ///
+    /// Errors (`Scene`) for `iso6336` (a mesh law) and invalid parameters.
+    pub fn pin_law(&self, face_width: f64) -> Result<PinLaw> {
+        match *self {
+            ContactLawSpec::Line {
+                youngs_modulus,
+                poisson_ratio,
+                damping,
+            } => {
+                let m = scene_material("pin", youngs_modulus, poisson_ratio)?;
+                Ok(PinLaw::Line {
+                    pin: m,
+                    disc: m,
+                    damping: ContactDamping::new(&damping)
+                        .map_err(|e| RvdynError::Scene(format!("contact.pin.damping: {e}")))?,
+                })
+            }
+            ContactLawSpec::Iso6336 { .. } => Err(RvdynError::Scene(
+                "contact.pin cannot be \"iso6336\" (a gear mesh law); use \"line\", \
+                 \"impact\" or \"palmgren\""
+                    .into(),
+            )),
+            _ => Ok(PinLaw::Impact(self.law(face_width)?)),
+        }
+    }
+
+    /// The sun/planet mesh law for the stage `stage`.
+    ///
+    /// Errors (`Scene`) for `line` (a pin law) and invalid parameters.
+    pub fn mesh_law(&self, stage: &InvoluteStage) -> Result<MeshLaw> {
+        match *self {
+            ContactLawSpec::Iso6336 { ramp, damping } => Ok(MeshLaw::Iso(
+                IsoMesh::new(
+                    stage.z_sun,
+                    stage.z_planet,
+                    stage.module,
+                    stage.pressure_angle,
+                    stage.face_width,
+                    ramp,
+                    &damping,
+                )
+                .map_err(|e| RvdynError::Scene(format!("contact.mesh: {e}")))?,
+            )),
+            ContactLawSpec::Line { .. } => Err(RvdynError::Scene(
+                "contact.mesh cannot be \"line\" (the pin/disc law); use \"iso6336\", \
+                 \"impact\" or \"palmgren\""
+                    .into(),
+            )),
+            _ => Ok(MeshLaw::Impact(self.law(stage.face_width)?)),
         }
     }
 }
@@ -172,6 +413,99 @@ pub struct ContactLaws {
     pub pin: ContactLawSpec,
     /// Sun / planet meshes (along the line of action).
     pub mesh: ContactLawSpec,
+}
+
+/// Friction in the reducer (all zero by default: frictionless, as the paper).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Friction {
+    /// Coulomb coefficient at the pin/disc contacts [-], in [0, 1].
+    #[serde(default)]
+    pub pin: f64,
+    /// Pins that roll in the housing: the sliding moves to the pin/housing contact, at the
+    /// radius `pin_rolling * rrp` (1 for a pin in a groove of its own radius, less for a
+    /// sleeve on a journal); the tangential force on the disc is then `pin * pin_rolling * N`.
+    /// `None`: pins fixed, sliding at the disc.
+    #[serde(default)]
+    pub pin_rolling: Option<f64>,
+    /// Coulomb coefficient at the sun/planet teeth [-], in [0, 1] (sliding along the tooth).
+    #[serde(default)]
+    pub mesh: f64,
+    /// Regularisation speed of the Coulomb law [m/s] (`contact::friction`): default 1e-3.
+    #[serde(default = "default_regularisation_speed")]
+    pub regularisation_speed: f64,
+    /// Palmgren friction torque of the joint bearings (compliant joints only).
+    #[serde(default)]
+    pub bearing: Option<BearingFriction>,
+}
+
+fn default_regularisation_speed() -> f64 {
+    1e-3
+}
+
+impl Default for Friction {
+    fn default() -> Self {
+        Self {
+            pin: 0.0,
+            pin_rolling: None,
+            mesh: 0.0,
+            regularisation_speed: default_regularisation_speed(),
+            bearing: None,
+        }
+    }
+}
+
+impl Friction {
+    /// Whether any friction acts.
+    pub fn any(&self) -> bool {
+        self.pin > 0.0 || self.mesh > 0.0 || self.bearing.is_some()
+    }
+
+    /// Check the fields; errors name the field and its limits.
+    pub fn check(&self) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Scene(m));
+        for (n, mu) in [("pin", self.pin), ("mesh", self.mesh)] {
+            if !(mu.is_finite() && (0.0..=1.0).contains(&mu)) {
+                return bad(format!(
+                    "friction.{n} must be a friction coefficient in [0, 1], got {mu}"
+                ));
+            }
+        }
+        if let Some(l) = self.pin_rolling
+            && !(l.is_finite() && l > 0.0 && l <= 1.0)
+        {
+            return bad(format!(
+                "friction.pin_rolling must be a lever ratio in (0, 1], got {l}"
+            ));
+        }
+        let v = self.regularisation_speed;
+        if !(v.is_finite() && v > 0.0) {
+            return bad(format!(
+                "friction.regularisation_speed must be > 0 m/s, got {v}"
+            ));
+        }
+        if let Some(b) = &self.bearing {
+            for (n, x) in [("f0", b.f0), ("f1", b.f1), ("viscosity", b.viscosity)] {
+                if !(x.is_finite() && x >= 0.0) {
+                    return bad(format!("friction.bearing.{n} must be >= 0, got {x}"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Palmgren bearing friction coefficients (`bearing::PalmgrenFriction`); the pitch diameters
+/// come from the bearings' rollers (linear bearings: 50 mm assumed).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BearingFriction {
+    /// Load-independent factor `f0` [-].
+    pub f0: f64,
+    /// Load factor `f1` [-].
+    pub f1: f64,
+    /// Oil kinematic viscosity [m^2/s].
+    pub viscosity: f64,
 }
 
 /// How the input starts.
@@ -314,6 +648,12 @@ pub struct Scene {
     pub joints: Joints,
     /// Contact laws of the pins and meshes.
     pub contact: ContactLaws,
+    /// Friction (default: none).
+    #[serde(default)]
+    pub friction: Friction,
+    /// Manufacturing and assembly errors of cranks, discs and carrier (default: none).
+    #[serde(default)]
+    pub errors: AssemblyErrors,
     /// The input drive.
     pub drive: Drive,
     /// The load on the output.

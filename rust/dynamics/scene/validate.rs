@@ -28,9 +28,7 @@ impl Scene {
             }
             crate::geometry::CycloidGeometry::check(self.disc_params(k))?;
         }
-        if self.cranks < 1 {
-            return err("cranks must be at least 1".into());
-        }
+        crate::geometry::involute::check_crank_count(self.cranks)?;
         if let Some(s) = &self.stage1 {
             s.validate()?;
             if s.planets != self.cranks {
@@ -63,8 +61,12 @@ impl Scene {
         {
             return err("pin_errors must be finite".into());
         }
-        if !(self.density.is_finite() && self.density > 0.0) {
-            return err(format!("density must be > 0 kg/m^3, got {}", self.density));
+        crate::geometry::cycloid::check_pin_radii(
+            self.cycloid.pin_radius,
+            &self.pin_errors.radius,
+        )?;
+        if let Err(e) = crate::geometry::mass::require_density(self.density) {
+            return err(format!("scene density: {e}"));
         }
         let i = &self.inertias;
         for (n, mp) in [
@@ -102,12 +104,30 @@ impl Scene {
             .into_iter()
             .filter_map(|(n, b)| b.map(|b| (n, b)))
             {
-                if !(b.stiffness.is_finite()
+                if !(b.clearance.is_finite() && b.clearance >= 0.0) {
+                    return err(format!(
+                        "joints.{n}.clearance must be >= 0 m (no preload), got {}",
+                        b.clearance
+                    ));
+                }
+                if let Some(r) = &b.rollers {
+                    r.check(&format!("joints.{n}"))?;
+                    if !(b.stiffness.is_finite()
+                        && b.stiffness >= 0.0
+                        && b.damping.is_finite()
+                        && b.damping >= 0.0)
+                    {
+                        return err(format!(
+                            "joints.{n} has rollers: stiffness and damping (a linear \
+                             spring-damper in parallel, 0 for none) must be >= 0, got {} N/m \
+                             and {} N s/m",
+                            b.stiffness, b.damping
+                        ));
+                    }
+                } else if !(b.stiffness.is_finite()
                     && b.stiffness > 0.0
                     && b.damping.is_finite()
-                    && b.damping >= 0.0
-                    && b.clearance.is_finite()
-                    && b.clearance >= 0.0)
+                    && b.damping >= 0.0)
                 {
                     return err(format!(
                         "joints.{n} needs stiffness > 0 N/m, damping >= 0 N s/m, clearance >= 0 m; got {b:?}"
@@ -115,9 +135,49 @@ impl Scene {
                 }
             }
         }
-        self.contact.pin.law(self.cycloid.face_width)?;
+        self.friction.check()?;
+        self.errors.check(
+            self.cranks as usize,
+            self.discs.len(),
+            self.cycloid.eccentricity,
+        )?;
+        if self.errors.any() && matches!(self.joints, Joints::Rigid) {
+            return err(
+                "errors (crank, hole and seat errors) need compliant joints: with ideal joints \
+                 they over-constrain the discs; set joints.kind = \"compliant\""
+                    .into(),
+            );
+        }
+        self.contact.pin.pin_law(self.cycloid.face_width)?;
+        if matches!(self.contact.pin, ContactLawSpec::Line { .. }) {
+            // The line law needs 1/r_pin + kappa_profile > 0 along the whole profile (a concave
+            // root flatter than the pin); check the most concave point, the root, on a fine
+            // sample of one lobe of every disc, with the largest pin.
+            let r_pin = self.cycloid.pin_radius
+                + self.pin_errors.radius.iter().cloned().fold(0.0, f64::max);
+            for k in 0..self.discs.len() {
+                let g = crate::geometry::CycloidGeometry::new(self.disc_params(k))?;
+                let lobe = std::f64::consts::TAU / f64::from(g.lobes());
+                for i in 0..=256 {
+                    let phi = lobe * (f64::from(i) / 256.0 - 0.5);
+                    let kp = crate::contact::line_contact::pin_disc_profile_curvature(
+                        g.centre_curve_curvature(phi),
+                        g.generating_pin_radius(),
+                    )?;
+                    if 1.0 / r_pin + kp <= 0.0 {
+                        return err(format!(
+                            "contact.pin = \"line\": disc {k}'s profile is more concave ({:.4e} m \
+                             radius at curve parameter {phi:.4} rad) than a pin of radius \
+                             {r_pin} m is convex: the pin would sit in a conformal or nested \
+                             seat, not a Hertz line contact",
+                            1.0 / kp
+                        ));
+                    }
+                }
+            }
+        }
         if let Some(s) = &self.stage1 {
-            self.contact.mesh.law(s.face_width)?;
+            self.contact.mesh.mesh_law(s)?;
         }
         match self.drive {
             Drive::Speed {

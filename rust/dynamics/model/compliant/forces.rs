@@ -2,6 +2,7 @@
 //! load and drive (docs/model.md#compliant-joint-model).
 
 use super::{CARRIER, CompliantModel, Flows, SUN, crank_index};
+use crate::contact::law::PinSite;
 use crate::dynamics::model::pin_contact::{
     DiscPose, SeparationBound, penetration_error, pin_query,
 };
@@ -29,12 +30,13 @@ impl CompliantModel {
         let mut out = Flows::default();
         qf.fill(0.0);
         let (thc, vc) = (x[CARRIER], v[CARRIER]);
-        let e = m.eccentricity;
         for (i, seat) in self.seats.iter().enumerate() {
             let ci = crank_index(i);
             let u = rotate(thc, *seat);
+            // Nominal seat (the mesh geometry) and actual seat (with its error: the bearing).
             let s = scaled(m.crank_radius, u);
             let s_v = scaled(vc, perp(s));
+            let s_act = rotate(thc, self.seat_vecs[i]);
             let p = [x[ci], x[ci + 1]];
             let pv = [v[ci], v[ci + 1]];
             let (alpha, va) = (x[ci + 2], v[ci + 2]);
@@ -42,18 +44,29 @@ impl CompliantModel {
             let dd = sub(pv, s_v);
             // Crank bearing: force on the crank centre, reaction on the carrier at s_i.
             if let Some(cb) = &self.crank_bearing {
-                let b = cb.load(d, dd);
+                let b = cb.load(sub(p, s_act), sub(pv, scaled(vc, perp(s_act))));
+                sink.bearing(0, i, b.force);
                 qf[ci] += b.force[0];
                 qf[ci + 1] += b.force[1];
-                qf[CARRIER] -= cross(s, b.force);
+                qf[CARRIER] -= cross(s_act, b.force);
                 out.dissipation += b.dissipation;
                 out.potential += b.energy;
+                if let Some([_, (pf, w_reg)]) = &self.bearing_friction {
+                    // Friction torque against the crank's rotation relative to the carrier.
+                    let w = va - vc;
+                    let m =
+                        pf.torque_unchecked(w, dot(b.force, b.force).sqrt()) * (w / w_reg).tanh();
+                    qf[ci + 2] -= m;
+                    qf[CARRIER] += m;
+                    out.dissipation += m * w;
+                    out.friction[2] += m * w;
+                }
             }
             // Eccentric bearings: force on the disc at H, opposite on the crank at E.
             for (k, disc) in m.discs.iter().enumerate() {
                 let dk = self.disc_index(k);
-                let (sa, ca) = (alpha + disc.phase).sin_cos();
-                let ecc = [e * ca, e * sa];
+                let (sa, ca) = (alpha + disc.phase + self.ecc_phase[i]).sin_cos();
+                let ecc = [self.ecc_radius[i] * ca, self.ecc_radius[i] * sa];
                 let e_pos = add(p, ecc);
                 let e_v = add(pv, scaled(va, perp(ecc)));
                 let o = [x[dk], x[dk + 1]];
@@ -63,6 +76,7 @@ impl CompliantModel {
                 let h_v = add(ov, scaled(v[dk + 2], perp(arm)));
                 let b = self.eccentric_bearing.load(sub(h, e_pos), sub(h_v, e_v));
                 let f = b.force;
+                sink.bearing(1, i * nd + k, f);
                 qf[dk] += f[0];
                 qf[dk + 1] += f[1];
                 qf[dk + 2] += cross(arm, f);
@@ -71,18 +85,38 @@ impl CompliantModel {
                 qf[ci + 2] -= cross(ecc, f);
                 out.dissipation += b.dissipation;
                 out.potential += b.energy;
+                if let Some([(pf, w_reg), _]) = &self.bearing_friction {
+                    // Friction torque against the eccentric's rotation relative to the disc.
+                    let w = va - v[dk + 2];
+                    let m = pf.torque_unchecked(w, dot(f, f).sqrt()) * (w / w_reg).tanh();
+                    qf[ci + 2] -= m;
+                    qf[dk + 2] += m;
+                    out.dissipation += m * w;
+                    out.friction[2] += m * w;
+                }
             }
-            // Sun/planet mesh i along w_i = sin(pa) u_i + cos(pa) z x u_i.
+            // Sun/planet mesh i. The sun pushes planet i along w_i = sin(pa) u_i + cos(pa)
+            // z x u_i on the drive flank and along sin(pa) u_i - cos(pa) z x u_i on the coast
+            // flank: both push the planet away from the sun. Each flank has its own
+            // deflection, `sign * rot - d . w` (sign +1 drive, -1 coast), so a radial approach
+            // of the planet closes both flanks and a reversed run mirrors a forward one.
             if let Some(mm) = &m.mesh {
                 let [sp, cp] = self.pressure;
                 let zu = perp(u);
-                let w = [sp * u[0] + cp * zu[0], sp * u[1] + cp * zu[1]];
-                let zw = perp(w);
                 let (rbs, rbp) = (mm.sun_base_radius, mm.planet_base_radius);
-                let delta = rbs * (x[SUN] - thc) + rbp * (alpha - thc) - dot(d, w);
-                let rate = rbs * (v[SUN] - vc) + rbp * (va - vc) - dot(dd, w) - vc * dot(d, zw);
-                let (f, elastic, pen, pen_rate) = mm.law.mesh(mm.backlash, delta, rate);
-                if pen > 0.0 {
+                let rot = rbs * (x[SUN] - thc) + rbp * (alpha - thc);
+                let rot_rate = rbs * (v[SUN] - vc) + rbp * (va - vc);
+                let s_mesh = rbs * (x[SUN] - thc) + mm.phases[i] * mm.base_pitch;
+                let half = 0.5 * mm.backlash;
+                let w_drive = [sp * u[0] + cp * zu[0], sp * u[1] + cp * zu[1]];
+                let w_coast = [sp * u[0] - cp * zu[0], sp * u[1] - cp * zu[1]];
+                let mut f_report = 0.0;
+                for (sign, w) in [(1.0, w_drive), (-1.0, w_coast)] {
+                    let zw = perp(w);
+                    let pen = sign * rot - dot(d, w) - half;
+                    if pen <= 0.0 {
+                        continue;
+                    }
                     if sink.checks_bounds() && (pen.is_nan() || pen >= m.max_penetration) {
                         return Err(penetration_error(
                             t,
@@ -91,19 +125,40 @@ impl CompliantModel {
                             &format!("sun/planet mesh {i}"),
                         ));
                     }
-                    // Q = -F grad(delta); d(delta)/d(th_c) includes ds_i/dth_c = z x s_i and
-                    // dw_i/dth_c = z x w_i.
-                    qf[SUN] -= f * rbs;
-                    qf[ci + 2] -= f * rbp;
+                    let rate = sign * rot_rate - dot(dd, w) - vc * dot(d, zw);
+                    // The coast flank runs through its tooth pairs in the mirrored order:
+                    // its mesh position is -s (a reversed run mirrors a forward one).
+                    let (lf, dk) = mm.law.evaluate(pen, rate, sign * s_mesh, want_energy);
+                    let f = lf.force;
+                    // Q = -F grad(pen); d(pen)/d(th_c) includes ds_i/dth_c = z x s_i and
+                    // dw/dth_c = z x w.
+                    qf[SUN] -= f * sign * rbs;
+                    qf[ci + 2] -= f * sign * rbp;
                     qf[ci] += f * w[0];
                     qf[ci + 1] += f * w[1];
-                    qf[CARRIER] += f * (rbs + rbp - dot(perp(s), w) + dot(d, zw));
-                    out.dissipation += (f.abs() - elastic.abs()) * pen_rate;
-                    if want_energy {
-                        out.potential += mm.law.elastic_energy(pen);
+                    qf[CARRIER] += f * (sign * (rbs + rbp) - dot(perp(s), w) + dot(d, zw));
+                    // Position-dependent stiffness: dV/ds with ds/dth_s = r_bs,
+                    // ds/dth_c = -r_bs (Oh, Grosh & Barber 2005).
+                    let dv_ds = 0.5 * dk * pen * pen * sign;
+                    qf[SUN] -= dv_ds * rbs;
+                    qf[CARRIER] += dv_ds * rbs;
+                    out.dissipation += (lf.force - lf.elastic) * rate;
+                    out.potential += lf.energy;
+                    // Tooth friction: torques on sun, planet and carrier (the rigid model's
+                    // law; the friction force on the planet centre is not applied).
+                    if let Some(fr) = &m.mesh_friction {
+                        let w1 = sign * (v[SUN] - vc);
+                        let w2 = sign * (va - vc);
+                        let (t1, t2, p) = mm.path.torques(fr, f, sign * s_mesh, w1, w2);
+                        qf[SUN] += sign * t1;
+                        qf[ci + 2] += sign * t2;
+                        qf[CARRIER] -= sign * (t1 + t2);
+                        out.dissipation += p;
+                        out.friction[1] += p;
                     }
+                    f_report += sign * f;
                 }
-                sink.mesh(i, f, delta);
+                sink.mesh(i, f_report, rot - dot(d, w_drive));
             }
         }
         for (k, disc) in m.discs.iter().enumerate() {
@@ -140,14 +195,43 @@ impl CompliantModel {
                 let n = pc.normal;
                 let lever = pc.lever();
                 let pen_rate = dot(n, ov) + vt * lever;
-                let f = m.pin_law.force(pen, pen_rate);
+                let site = PinSite {
+                    geometry: &disc.geometry,
+                    phi: pc.phi,
+                    pin_radius: pin.radius,
+                    depth: disc.body_depth,
+                };
+                let lf = m.pin_law.evaluate(pen, pen_rate, &site, want_energy)?;
+                let f = lf.force;
                 qf[dk] -= f * n[0];
                 qf[dk + 1] -= f * n[1];
                 qf[dk + 2] -= f * lever;
-                out.dissipation += (f - m.pin_law.elastic_force(pen)) * pen_rate;
-                if want_energy {
-                    out.potential += m.pin_law.elastic_energy(pen);
+                // Sliding friction (see the rigid model): material point velocity
+                // O' + th' z x arm, force ft t on the disc, t = z x n.
+                if let Some(fr) = &m.pin_friction {
+                    let arm = pc.arm;
+                    let vx = [ov[0] - vt * arm[1], ov[1] + vt * arm[0]];
+                    let vs = n[0] * vx[1] - n[1] * vx[0];
+                    let ft = fr.force(vs, f);
+                    qf[dk] -= ft * n[1];
+                    qf[dk + 1] += ft * n[0];
+                    qf[dk + 2] += ft * (arm[0] * n[0] + arm[1] * n[1]);
+                    let p = -ft * vs;
+                    out.dissipation += p;
+                    out.friction[0] += p;
                 }
+                // Location term of a line law (see `PinLaw::location_slope`).
+                if let Some(ls) = m
+                    .pin_law
+                    .location_slope(lf.elastic, &site, pin.centre, o, th)
+                {
+                    let (fo, mt) = ls.forces();
+                    qf[dk] += fo[0];
+                    qf[dk + 1] += fo[1];
+                    qf[dk + 2] += mt;
+                }
+                out.dissipation += (f - lf.elastic) * pen_rate;
+                out.potential += lf.energy;
                 // Moment of the pin's force (-f n) on the disc about the disc centre.
                 sink.pin(k, j, f, pen, -f * lever, add(o, pc.arm), n);
             }
@@ -155,9 +239,9 @@ impl CompliantModel {
         if self.crank_bearing.is_none() {
             // Rigid crank bearings: a force on a crank centre turns the carrier, through the
             // seat's lever (virtual work with ds_i/dth_c = z x s_i).
-            for (i, seat) in self.seats.iter().enumerate() {
+            for i in 0..self.cranks {
                 let ci = crank_index(i);
-                let s = scaled(m.crank_radius, rotate(thc, *seat));
+                let s = rotate(thc, self.seat_vecs[i]);
                 qf[CARRIER] += cross(s, [qf[ci], qf[ci + 1]]);
                 qf[ci] = 0.0;
                 qf[ci + 1] = 0.0;

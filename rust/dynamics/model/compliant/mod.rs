@@ -40,6 +40,7 @@
 use std::cell::Cell;
 use std::f64::consts::TAU;
 
+use crate::bearing::PalmgrenFriction;
 use crate::dynamics::model::laws::BearingLaw;
 pub use crate::dynamics::model::laws::{BearingLoad, linear_bearing as bearing_load};
 use crate::dynamics::model::parts::Parts;
@@ -68,11 +69,13 @@ pub fn default_joints() -> Joints {
             stiffness: 1.0e9,
             damping: 1.0e4,
             clearance: 0.0,
+            rollers: None,
         },
         crank_bearing: Some(Bearing {
             stiffness: 2.0e9,
             damping: 1.0e4,
             clearance: 0.0,
+            rollers: None,
         }),
     }
 }
@@ -80,10 +83,12 @@ pub fn default_joints() -> Joints {
 /// Energy flows of one force evaluation.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Flows {
-    /// Power dissipated by contact and bearing damping [W].
+    /// Power dissipated by contact and bearing damping and by friction [W].
     dissipation: f64,
     /// Elastic energy of the contacts and bearings [J] (contacts only when asked for).
     potential: f64,
+    /// Friction power per family [W]: pins, teeth, bearings (part of `dissipation`).
+    friction: [f64; 3],
 }
 
 /// The compliant-joint reducer model (a [`MechanicalSystem`] in its free coordinates).
@@ -92,12 +97,12 @@ pub struct CompliantModel {
     /// Geometry, laws, inertias, drive and load (shared with the rigid model).
     pub(crate) parts: Parts,
     /// Law of the needle bearing between each eccentric and its disc hole.
-    pub eccentric_bearing: BearingLaw,
+    pub(crate) eccentric_bearing: BearingLaw,
     /// `None`: rigid crank bearings, the crank centres stay in their seats on the carrier
     /// (their mass then turns with the carrier: `n m_cr r_cr^2` joins its inertia).
-    pub crank_bearing: Option<BearingLaw>,
+    pub(crate) crank_bearing: Option<BearingLaw>,
     /// Number of cranks.
-    pub cranks: usize,
+    pub(crate) cranks: usize,
     /// `(cos gamma_i, sin gamma_i)` of each crank seat.
     seats: Vec<[f64; 2]>,
     /// Disc hole centres `h_ik` in the disc frame, at `i * discs + k` [m].
@@ -105,11 +110,11 @@ pub struct CompliantModel {
     /// `(sin, cos)` of the pressure angle: `w_i = sin u_i + cos (z x u_i)`.
     pressure: [f64; 2],
     /// Diagonal mass of every full coordinate [kg or kg m^2].
-    pub mass: Vec<f64>,
+    pub(crate) mass: Vec<f64>,
     /// Free coordinates (indices into the full vector).
-    pub free: Vec<usize>,
+    pub(crate) free: Vec<usize>,
     /// Prescribed coordinates (the sun, or every crank rotation without a first stage).
-    pub prescribed: Vec<usize>,
+    pub(crate) prescribed: Vec<usize>,
     /// Coordinates the input torque acts on (shared equally).
     input: Vec<usize>,
     /// Lever per free coordinate [m per unit].
@@ -120,6 +125,14 @@ pub struct CompliantModel {
     /// Skip the exact query of a pin that provably cannot touch ([`SeparationBound`]).
     pub(crate) skip_separated: bool,
     separation: Vec<Cell<SeparationBound>>,
+    /// Crank seats in the carrier frame, `r_cr (cos g_i, sin g_i)` plus the seat error [m].
+    seat_vecs: Vec<[f64; 2]>,
+    /// Eccentricity [m] and phase error [rad] of each crank.
+    ecc_radius: Vec<f64>,
+    ecc_phase: Vec<f64>,
+    /// Palmgren friction of the eccentric and crank bearings, with the regularisation speeds
+    /// [rad/s] of their relative rotation.
+    bearing_friction: Option<[(PalmgrenFriction, f64); 2]>,
 }
 
 impl CompliantModel {
@@ -146,12 +159,51 @@ impl CompliantModel {
                 [c, s]
             })
             .collect();
+        let errs = &scene.errors;
         let mut holes = Vec::with_capacity(n * nd);
-        for seat in &seats {
-            for d in &base.discs {
-                holes.push(rotate(-d.angle_offset, scaled(base.crank_radius, *seat)));
+        for (i, seat) in seats.iter().enumerate() {
+            for (k, d) in base.discs.iter().enumerate() {
+                let dh = errs.disc_holes.get(i * nd + k).copied().unwrap_or([0.0; 2]);
+                holes.push(add(
+                    rotate(-d.angle_offset, scaled(base.crank_radius, *seat)),
+                    dh,
+                ));
             }
         }
+        let seat_vecs: Vec<[f64; 2]> = seats
+            .iter()
+            .enumerate()
+            .map(|(i, seat)| {
+                add(
+                    scaled(base.crank_radius, *seat),
+                    errs.carrier_seats.get(i).copied().unwrap_or([0.0; 2]),
+                )
+            })
+            .collect();
+        let ecc_radius: Vec<f64> = (0..n)
+            .map(|i| base.eccentricity + errs.crank_eccentricity.get(i).copied().unwrap_or(0.0))
+            .collect();
+        let ecc_phase: Vec<f64> = (0..n)
+            .map(|i| errs.crank_phase.get(i).copied().unwrap_or(0.0))
+            .collect();
+        let bearing_friction = scene.friction.bearing.map(|bf| {
+            // Pitch diameter from the rollers; 50 mm for a linear bearing (assumed).
+            let pf = |b: Option<&Bearing>| {
+                let dm = b
+                    .and_then(|b| b.rollers.map(|r| r.pitch_diameter))
+                    .unwrap_or(0.05);
+                (
+                    PalmgrenFriction {
+                        f0: bf.f0,
+                        f1: bf.f1,
+                        pitch_diameter: dm,
+                        viscosity: bf.viscosity,
+                    },
+                    scene.friction.regularisation_speed / (0.5 * dm),
+                )
+            };
+            [pf(Some(&eccentric_bearing)), pf(crank_bearing.as_ref())]
+        });
         let pressure = scene.stage1.as_ref().map_or([0.0, 1.0], |s| {
             let (s, c) = s.pressure_angle.sin_cos();
             [s, c]
@@ -203,8 +255,8 @@ impl CompliantModel {
         let scale = free.iter().map(|&i| lever[i]).collect();
         Ok(Self {
             parts: base,
-            eccentric_bearing: BearingLaw::Linear(eccentric_bearing),
-            crank_bearing: crank_bearing.map(BearingLaw::Linear),
+            eccentric_bearing: BearingLaw::new(&eccentric_bearing)?,
+            crank_bearing: crank_bearing.as_ref().map(BearingLaw::new).transpose()?,
             cranks: n,
             seats,
             holes,
@@ -217,6 +269,10 @@ impl CompliantModel {
             warm_seeds: vec![Cell::new(WarmStart::default()); nd * zp],
             skip_separated: true,
             separation: vec![Cell::new(SeparationBound::default()); nd * zp],
+            seat_vecs,
+            ecc_radius,
+            ecc_phase,
+            bearing_friction,
         })
     }
 
@@ -246,17 +302,25 @@ impl CompliantModel {
         if steady && m.mesh.is_some() {
             v[SUN] = w_in;
         }
-        for (i, seat) in self.seats.iter().enumerate() {
+        for i in 0..self.cranks {
             let ci = crank_index(i);
-            let p = scaled(m.crank_radius, *seat);
+            let p = self.seat_vecs[i];
             let pv = scaled(wc, perp(p));
             x[ci..ci + 3].copy_from_slice(&[p[0], p[1], 0.0]);
             v[ci..ci + 3].copy_from_slice(&[pv[0], pv[1], wa]);
         }
+        let nd = m.discs.len();
         for (k, d) in m.discs.iter().enumerate() {
             let dk = self.disc_index(k);
-            let (s, c) = d.phase.sin_cos();
-            let o = [m.eccentricity * c, m.eccentricity * s];
+            // The disc centre that best fits its holes onto the eccentrics (least squares:
+            // the mean of E_ik - h_ik); the kinematic centre without errors.
+            let mut o = [0.0; 2];
+            for i in 0..self.cranks {
+                let (s, c) = (d.phase + self.ecc_phase[i]).sin_cos();
+                let e_pos = add(self.seat_vecs[i], scaled(self.ecc_radius[i], [c, s]));
+                let h = rotate(d.angle_offset, self.holes[i * nd + k]);
+                o = add(o, scaled(1.0 / self.cranks as f64, sub(e_pos, h)));
+            }
             let ov = scaled(wa, perp(o));
             x[dk..dk + 3].copy_from_slice(&[o[0], o[1], d.angle_offset]);
             v[dk..dk + 3].copy_from_slice(&[ov[0], ov[1], wc]);
@@ -271,9 +335,9 @@ impl CompliantModel {
         if self.crank_bearing.is_some() {
             return;
         }
-        for (i, seat) in self.seats.iter().enumerate() {
+        for i in 0..self.cranks {
             let ci = crank_index(i);
-            let s = scaled(self.parts.crank_radius, rotate(x[CARRIER], *seat));
+            let s = rotate(x[CARRIER], self.seat_vecs[i]);
             let sv = scaled(v[CARRIER], perp(s));
             x[ci..ci + 2].copy_from_slice(&s);
             v[ci..ci + 2].copy_from_slice(&sv);
@@ -316,14 +380,14 @@ impl CompliantModel {
         let nd = m.discs.len();
         let mut crank = Vec::with_capacity(self.cranks);
         let mut ecc = Vec::with_capacity(self.cranks * nd);
-        for (i, seat) in self.seats.iter().enumerate() {
+        for i in 0..self.cranks {
             let ci = crank_index(i);
             let p = [x[ci], x[ci + 1]];
-            crank.push(sub(p, scaled(m.crank_radius, rotate(x[CARRIER], *seat))));
+            crank.push(sub(p, rotate(x[CARRIER], self.seat_vecs[i])));
             for (k, d) in m.discs.iter().enumerate() {
                 let dk = self.disc_index(k);
-                let (s, c) = (x[ci + 2] + d.phase).sin_cos();
-                let e_pos = add(p, [m.eccentricity * c, m.eccentricity * s]);
+                let (s, c) = (x[ci + 2] + d.phase + self.ecc_phase[i]).sin_cos();
+                let e_pos = add(p, [self.ecc_radius[i] * c, self.ecc_radius[i] * s]);
                 let h = add(
                     [x[dk], x[dk + 1]],
                     rotate(x[dk + 2], self.holes[i * nd + k]),
@@ -452,6 +516,7 @@ impl ReducerModel for CompliantModel {
             input_torque,
             kinetic_energy: self.kinetic_energy(&xv),
             potential_energy: flows.potential,
+            friction_power: flows.friction,
         })
     }
 }

@@ -19,6 +19,7 @@ fn joints(k: f64, c: f64, clearance: f64) -> Joints {
         stiffness: k,
         damping: c,
         clearance,
+        rollers: None,
     };
     Joints::Compliant {
         eccentric_bearing: b,
@@ -281,6 +282,7 @@ fn rigid_cranks(k: f64, c: f64) -> Joints {
             stiffness: k,
             damping: c,
             clearance: 0.0,
+            rollers: None,
         },
         crank_bearing: None,
     }
@@ -373,6 +375,7 @@ fn bearing_clearance_opens_and_closes() {
         stiffness: k,
         damping: 1e4,
         clearance: c,
+        rollers: None,
     };
     let s = scene(
         "idle",

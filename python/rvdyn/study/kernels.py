@@ -1,0 +1,148 @@
+"""Kernels: the analysis run for each sample, reduced to a few scalar metrics.
+
+A kernel is a picklable object with ``name``, ``metrics`` (the metric names it returns, or
+``None`` if unknown in advance) and ``__call__(scene) -> dict[str, float]``. Built-in kernels
+are looked up by name in :data:`KERNELS` (``register_kernel`` adds one):
+
+``"dynamic"``  :class:`DynamicKernel`: :func:`rvdyn.simulate` then summary metrics.
+``"ltca"``     the loaded tooth contact analysis metric set (transmission error, rigidity, lost
+               motion): not in this version; asking for it raises :class:`rvdyn.ParameterError`.
+
+Any picklable top-level function ``f(scene) -> dict`` is a kernel too (``FunctionKernel``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..scene import Scene
+
+__all__ = ["DynamicKernel", "FunctionKernel", "KERNELS", "register_kernel", "get_kernel", "DYNAMIC_METRICS"]
+
+#: Metrics of :class:`DynamicKernel`, evaluated on the window [t_start, t_end] (SI units).
+DYNAMIC_METRICS: dict[str, str] = {
+    "peak_pin_force": "largest pin normal force on any disc [N]",
+    "loaded_pins_min": "fewest pins in contact on any disc [-]",
+    "loaded_pins_mean": "mean number of pins in contact, averaged over discs [-]",
+    "output_speed_error": "mean output speed / (mean input speed / ratio) - 1 [-]",
+    "output_speed_ripple": "output speed peak-to-peak [rad/s]",
+    "transmission_error_pp": "peak-to-peak of output angle - input angle / ratio [rad]",
+    "peak_input_torque": "largest |input torque| [N m]",
+}
+
+
+@dataclass(frozen=True)
+class DynamicKernel:
+    """A dynamic run of ``t_end`` [s] reduced to :data:`DYNAMIC_METRICS`.
+
+    t_start: start of the evaluated window [s] (default 20 % of t_end, after the start-up
+    transient). integrator, dt: as for :func:`rvdyn.simulate` (None: its defaults). Only the motion, pin and mesh
+    channels are recorded."""
+
+    t_end: float = 0.5
+    t_start: float | None = None
+    integrator: str | None = None
+    dt: float | None = None
+    name: str = field(default="dynamic", init=False)
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.t_end, (int, float)) and math.isfinite(self.t_end) and self.t_end > 0):
+            raise ParameterError(f"dynamic kernel: t_end must be a finite time > 0 [s], got {self.t_end!r}")
+        if self.t_start is not None and not (math.isfinite(self.t_start) and 0 <= self.t_start < self.t_end):
+            raise ParameterError(f"dynamic kernel: t_start must lie in [0, t_end), got {self.t_start!r}")
+
+    @property
+    def metrics(self) -> tuple[str, ...]:
+        return tuple(DYNAMIC_METRICS)
+
+    def __call__(self, scene: Scene) -> dict[str, float]:
+        from ..simulation import simulate
+
+        res = simulate(scene, self.t_end, self.integrator, dt=self.dt, channels=["motion", "pins", "mesh"],
+                       progress=False)
+        t = res.t
+        t0 = 0.2 * self.t_end if self.t_start is None else self.t_start
+        i0 = min(int(np.searchsorted(t, t0)), len(t) - 2)
+        w = slice(i0, None)
+        ratio = _ratio(scene)
+        span = float(t[-1] - t[i0])
+        mean_in = float(res.sun_angle[-1] - res.sun_angle[i0]) / span
+        mean_out = float(res.carrier_angle[-1] - res.carrier_angle[i0]) / span
+        te = res.carrier_angle[w] - res.sun_angle[w] / ratio
+        loaded = res.loaded_pins[w]
+        return {
+            "peak_pin_force": float(np.max(res.pin_force[w])),
+            "loaded_pins_min": float(np.min(loaded)),
+            "loaded_pins_mean": float(np.mean(loaded)),
+            "output_speed_error": mean_out / (mean_in / ratio) - 1.0 if mean_in != 0 else math.nan,
+            "output_speed_ripple": float(np.ptp(res.carrier_speed[w])),
+            "transmission_error_pp": float(np.ptp(te)),
+            "peak_input_torque": float(np.max(np.abs(res.input_torque[w]))),
+        }
+
+
+def _ratio(scene: Scene) -> float:
+    """Transmission ratio input speed / output speed of the scene."""
+    ratio = getattr(scene, "ratio", None)
+    if ratio is not None:
+        return float(ratio() if callable(ratio) else ratio)
+    from .._core import transmission_ratio
+
+    stage = scene["stage1"]
+    pins = int(scene["cycloid.pins"])
+    if stage is None:  # the input drives the cranks (as Scene.ratio): -(zp - 1) = -zc
+        return -float(pins - 1)
+    return float(transmission_ratio(int(stage["z_sun"]), int(stage["z_planet"]), pins))
+
+
+@dataclass(frozen=True)
+class FunctionKernel:
+    """A kernel from a picklable top-level function ``fn(scene) -> {metric: float}``;
+    ``metrics`` lists its metric names (lets criteria be checked before the study runs)."""
+
+    fn: Callable[[Scene], Mapping[str, float]]
+    metrics: tuple[str, ...] | None = None
+    name: str = "function"
+
+    def __call__(self, scene: Scene) -> dict[str, float]:
+        return {k: float(v) for k, v in self.fn(scene).items()}
+
+
+def _ltca(**options: Any) -> Any:
+    raise ParameterError("kernel 'ltca' (loaded tooth contact analysis: transmission error, rigidity, lost motion) "
+                         "is not available in this version of rvdyn; use kernel='dynamic' or a function kernel")
+
+
+#: Kernel factories by name: ``factory(**options) -> kernel``.
+KERNELS: dict[str, Callable[..., Any]] = {"dynamic": DynamicKernel, "ltca": _ltca}
+
+
+def register_kernel(name: str, factory: Callable[..., Any]) -> None:
+    """Make ``factory(**options)`` available as ``kernel=name`` (replaces an entry)."""
+    if not isinstance(name, str) or not name:
+        raise ParameterError(f"kernel name must be a non-empty string, got {name!r}")
+    KERNELS[name] = factory
+
+
+def get_kernel(kernel: Any, **options: Any) -> Any:
+    """A kernel object from a name (``"dynamic"``, options passed to its factory), a kernel
+    object, or a plain function."""
+    if isinstance(kernel, str):
+        if kernel not in KERNELS:
+            raise ParameterError(f"unknown kernel {kernel!r}; known: {sorted(KERNELS)}")
+        try:
+            return KERNELS[kernel](**options)
+        except TypeError as exc:
+            raise ParameterError(f"kernel {kernel!r}: {exc}") from None
+    if options:
+        raise ParameterError("kernel options are for a kernel given by name")
+    if hasattr(kernel, "metrics") and callable(kernel):
+        return kernel
+    if callable(kernel):
+        return FunctionKernel(kernel, None, getattr(kernel, "__name__", "function"))
+    raise ParameterError(f"kernel must be a name {sorted(KERNELS)}, a kernel object or a function, got {kernel!r}")

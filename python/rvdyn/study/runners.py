@@ -1,0 +1,254 @@
+"""Runners: where the samples of a study are evaluated.
+
+A runner is anything with ``map(fn, items)``: :class:`ThreadRunner` (the default; the core
+releases the GIL, so threads run in parallel), a :mod:`concurrent.futures` executor
+(``ThreadPoolExecutor``, ``ProcessPoolExecutor``), a ``dask.distributed.Client`` (its
+``map``/``gather`` is used with ``retries``, so a task whose worker died is run again) or
+``ray.util.multiprocessing.Pool``. Strings name one: ``"threads"``, ``"threads:4"``,
+``"processes:2"``, a Dask scheduler address ``"tcp://host:8786"``, or ``"ray"`` /
+``"ray://host:10001"``.
+
+Tasks are the top-level function :func:`evaluate_batch` bound to a picklable :class:`Task`
+(scene, kernel, tolerance layout); each returns small records ``(sample id, metrics, error)``.
+A sample whose analysis raises is a record with the error message; a task that the runner
+loses (worker died, broken pool) is recorded as failed with the runner's message: no sample is
+dropped.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import functools
+import os
+import pickle
+import traceback
+from dataclasses import dataclass
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from ..errors import ParameterError, RvdynError
+from ..scene import Scene
+from .spec import Layout, apply_values
+
+__all__ = ["RunnerError", "ThreadRunner", "Task", "Record", "evaluate", "evaluate_batch", "resolve_runner", "THREAD_ENV"]
+
+#: Environment variables set in worker processes so each worker runs single-threaded native
+#: code (rayon in the Rust core, BLAS/OpenMP in numpy): n workers use n cores, not n^2.
+THREAD_ENV = ("RAYON_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+#: One evaluated sample: (sample id, {metric: value}, error message or "").
+Record = tuple[int, dict[str, float], str]
+
+
+class RunnerError(RvdynError, RuntimeError):
+    """The runner lost every task of a chunk (a broken process pool, workers that keep dying):
+    the study stops. The rows so far (the lost ones with their error) are on disk when the study
+    has ``out``; running it again resumes (``retry_failed=True`` reruns the lost samples)."""
+
+
+@dataclass(frozen=True)
+class Task:
+    """Everything a worker needs besides the sample values (picklable, sent with each task)."""
+
+    scene: Scene
+    kernel: Any
+    layout: Layout
+    threads: int = 1
+    driver_pid: int = 0
+
+
+_configured = False
+
+
+def _configure_worker(threads: int) -> None:
+    global _configured
+    if not _configured:
+        for name in THREAD_ENV:
+            os.environ.setdefault(name, str(threads))
+        _configured = True
+
+
+def evaluate(task: Task, sample: tuple[int, Sequence[float]]) -> Record:
+    """Evaluate one sample ``(id, values)``: set the toleranced fields of the scene and run the
+    kernel. Any exception becomes the record's error message (the study goes on)."""
+    sid, values = sample
+    try:
+        scene = apply_values(task.scene, task.layout, np.asarray(values, dtype=float))
+        metrics = task.kernel(scene)
+        return int(sid), {str(k): float(v) for k, v in metrics.items()}, ""
+    except Exception as exc:  # noqa: BLE001 - a failed sample is a row, whatever failed
+        msg = f"{type(exc).__name__}: {exc}".strip()
+        if not isinstance(exc, ValueError | ArithmeticError | RuntimeError):
+            msg += " | " + traceback.format_exc(limit=3).replace("\n", " ")[-400:]
+        return int(sid), {}, msg
+
+
+def evaluate_batch(task: Task, batch: Sequence[tuple[int, Sequence[float]]]) -> list[Record]:
+    """Evaluate a batch of samples in order (one task of a runner)."""
+    if task.driver_pid and os.getpid() != task.driver_pid:
+        _configure_worker(task.threads)
+    return [evaluate(task, s) for s in batch]
+
+
+class ThreadRunner:
+    """A thread pool with ``map`` (default ``workers``: the number of CPUs)."""
+
+    def __init__(self, workers: int | None = None):
+        if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+            raise ParameterError(f"runner: workers must be a positive integer, got {workers!r}")
+        self.workers = workers or os.cpu_count() or 1
+
+    def map(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
+        with concurrent.futures.ThreadPoolExecutor(self.workers) as ex:
+            return list(ex.map(fn, items))
+
+    def __repr__(self) -> str:
+        return f"ThreadRunner({self.workers})"
+
+
+class _Failure:
+    """A task the runner lost (its message)."""
+
+    def __init__(self, message: str):
+        self.message = message
+
+
+class Mapper:
+    """Adapts a runner: ``run(fn, items)`` returns one entry per item, in order: the task's
+    result, or a :class:`_Failure` if the runner lost it. ``close()`` shuts down what it started."""
+
+    def __init__(self, runner: Any, owned: bool = False, retries: int = 2, in_process: bool = False):
+        self.runner = runner
+        self.owned = owned
+        self.retries = retries
+        self.in_process = in_process
+        self._scattered: tuple[Any, Any] | None = None
+        mod = type(runner).__module__
+        self.is_dask = mod.startswith("distributed") and hasattr(runner, "submit") and hasattr(runner, "gather")
+
+    def run(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
+        if self.is_dask:
+            return self._run_dask(fn, items)
+        out: list[Any] = []
+        try:
+            for r in self.runner.map(fn, items):
+                out.append(r)
+        except Exception as exc:  # noqa: BLE001 - the runner lost the remaining tasks
+            msg = f"runner failed: {type(exc).__name__}: {exc}"
+            out += [_Failure(msg)] * (len(items) - len(out))
+        return out
+
+    def _run_dask(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
+        if isinstance(fn, functools.partial) and len(fn.args) == 1 and not fn.keywords:
+            # Send the shared task (scene, kernel, layout) to every worker once, not with each item.
+            if self._scattered is None or self._scattered[0] is not fn.args[0]:
+                [fut] = self.runner.scatter([fn.args[0]], broadcast=True, hash=False)
+                self._scattered = (fn.args[0], fut)
+            futures = self.runner.map(fn.func, [self._scattered[1]] * len(items), list(items), pure=False,
+                                      retries=self.retries)
+        else:
+            futures = self.runner.map(fn, list(items), pure=False, retries=self.retries)
+        from distributed import wait  # type: ignore[import-untyped, import-not-found, unused-ignore]
+
+        wait(futures)  # type: ignore[no-untyped-call, unused-ignore]
+        done = [f for f in futures if f.status == "finished"]
+        results = iter(self.runner.gather(done, errors="raise")) if done else iter(())
+        out: list[Any] = []
+        for f in futures:
+            if f.status == "finished":
+                out.append(next(results))
+                continue
+            try:  # retries exhausted (KilledWorker, ...) or cancelled
+                exc = f.exception()
+                out.append(_Failure(f"runner failed: {type(exc).__name__}: {exc}"))
+            except Exception as err:  # noqa: BLE001
+                out.append(_Failure(f"runner failed: {type(err).__name__}: {err}"))
+        del futures, done
+        return out
+
+    def close(self) -> None:
+        self._scattered = None
+        if not self.owned:
+            return
+        # A Dask client is closed, never shut down (that would stop a shared cluster).
+        for name in (("close",) if self.is_dask else ("shutdown", "close")):
+            method = getattr(self.runner, name, None)
+            if method is not None:
+                method()
+                break
+
+
+def _dask_client(address: str, timeout: float) -> Any:
+    try:
+        from distributed import Client  # type: ignore[import-untyped, import-not-found, unused-ignore]
+    except ImportError:
+        raise ParameterError(f"runner {address!r} needs Dask: pip install 'rvdyn[dask]'") from None
+    try:
+        return Client(address, timeout=f"{timeout}s")  # type: ignore[no-untyped-call, unused-ignore]
+    except (OSError, TimeoutError) as exc:
+        raise ParameterError(f"runner: no Dask scheduler answers at {address!r} within {timeout:g} s ({exc})") from None
+
+
+def _ray_pool(address: str | None, workers: int | None) -> Any:
+    try:
+        import ray  # type: ignore[import-untyped, import-not-found, unused-ignore]
+        from ray.util.multiprocessing import Pool  # type: ignore[import-untyped, import-not-found, unused-ignore]
+    except ImportError:
+        raise ParameterError("runner 'ray' needs Ray: pip install 'rvdyn[ray]'") from None
+    try:
+        if not ray.is_initialized():
+            ray.init(address=address, num_cpus=None if address else workers, include_dashboard=False,
+                     log_to_driver=False)
+        return Pool(processes=workers)
+    except (ConnectionError, TimeoutError, RuntimeError, ValueError) as exc:
+        raise ParameterError(f"runner: no Ray cluster answers at {address!r} ({exc})") from None
+
+
+def _workers(spec: str, text: str) -> int | None:
+    if not text:
+        return None
+    if not text.isdigit() or int(text) < 1:
+        raise ParameterError(f"runner {spec!r}: the worker count must be a positive integer")
+    return int(text)
+
+
+def resolve_runner(runner: Any, retries: int = 2, timeout: float = 10.0) -> Mapper:
+    """A :class:`Mapper` for ``runner``: None / int (threads), a string (see the module
+    docstring), or any object with ``map``."""
+    if runner is None:
+        return Mapper(ThreadRunner(), owned=True, in_process=True)
+    if isinstance(runner, (int, np.integer)) and not isinstance(runner, bool):
+        return Mapper(ThreadRunner(int(runner)), owned=True, in_process=True)
+    if isinstance(runner, str):
+        kind, _, rest = runner.partition(":")
+        if kind == "threads":
+            return Mapper(ThreadRunner(_workers(runner, rest)), owned=True, in_process=True)
+        if kind == "processes":
+            import multiprocessing
+
+            ex = concurrent.futures.ProcessPoolExecutor(_workers(runner, rest),
+                                                        mp_context=multiprocessing.get_context("spawn"))
+            return Mapper(ex, owned=True, retries=retries)
+        if kind in ("tcp", "tls", "ucx", "inproc"):
+            return Mapper(_dask_client(runner, timeout), owned=True, retries=retries)
+        if kind == "ray":
+            address = runner if rest.startswith("//") else None
+            workers = None if rest.startswith("//") else _workers(runner, rest)
+            return Mapper(_ray_pool(address, workers), owned=True, retries=retries)
+        raise ParameterError(f"runner {runner!r}: use 'threads[:N]', 'processes[:N]', a Dask address "
+                             "'tcp://host:port', 'ray[:N]' or 'ray://host:port', or an object with map()")
+    if not callable(getattr(runner, "map", None)):
+        raise ParameterError(f"runner must have a map(fn, items) method (a thread pool, executor, Dask client, "
+                             f"Ray pool), got {type(runner).__name__}")
+    in_process = isinstance(runner, (ThreadRunner, concurrent.futures.ThreadPoolExecutor))
+    return Mapper(runner, owned=False, retries=retries, in_process=in_process)
+
+
+def check_picklable(task: Task) -> None:
+    """Raise a clear error if a task cannot be sent to another process."""
+    try:
+        pickle.dumps(functools.partial(evaluate_batch, task))
+    except Exception as exc:  # noqa: BLE001
+        raise ParameterError(f"kernel {task.kernel!r} cannot be sent to worker processes (pickle: {exc}); "
+                             "use a top-level function or a kernel name") from None

@@ -1,0 +1,328 @@
+"""Tolerance studies (rvdyn.study): specs, samplers, statistics, storage and resume, bad input.
+
+Fast: function kernels or dynamic runs of 0.01 s, a few samples, the in-process thread runner.
+The runner-identity tests (processes, Dask, Ray) are in test_study_runners.py.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+
+import numpy as np
+import pytest
+
+import rvdyn
+from rvdyn.study import (Correlation, Criterion, FunctionKernel, LatinHypercube, MonteCarlo, Tolerance, design,
+                         expand)
+
+SCENE = rvdyn.Scene.paper("rated")
+TINY = {"t_end": 0.01}
+
+
+def linear_metric(scene: rvdyn.Scene) -> dict[str, float]:
+    """A cheap additive kernel: y = 3 d_rrp / 1e-5 + 1 d_rp / 1e-5 [-]."""
+    return {"y": 3.0 * scene["cycloid.d_rrp"] / 1e-5 + scene["cycloid.d_rp"] / 1e-5}
+
+
+def failing_metric(scene: rvdyn.Scene) -> dict[str, float]:
+    """Raises for positive d_rrp (a sample whose analysis fails)."""
+    if scene["cycloid.d_rrp"] > 0:
+        raise rvdyn.SimulationError("d_rrp > 0 is not supported by this kernel")
+    return {"y": scene["cycloid.d_rrp"]}
+
+
+CALLS: list[float] = []
+
+
+def counting_metric(scene: rvdyn.Scene) -> dict[str, float]:
+    CALLS.append(scene["cycloid.d_rrp"])
+    return {"y": scene["cycloid.d_rrp"] * 2.0}
+
+
+TOLS = [Tolerance("cycloid.d_rrp", tol=1e-5), Tolerance("cycloid.d_rp", lower=-2e-5, upper=0.0, dist="uniform")]
+
+
+# ------------------------------------------------------------------------------------- specs
+def test_expand_list_fields_and_per_disc_defaults() -> None:
+    lay = expand(SCENE, [Tolerance("pin_errors.radius", tol=5e-6), Tolerance("pin_errors.position", tol=1e-5),
+                         Tolerance("discs.1.d_rrp", tol=1e-6)])
+    cols = lay.columns
+    assert cols[:2] == ["pin_errors.radius.0", "pin_errors.radius.1"]
+    assert len(cols) == 24 + 48 + 1
+    assert "pin_errors.position.23.1" in cols and cols[-1] == "discs.1.d_rrp"
+    # per-disc modification: nominal from the cycloid's (0 in the paper scene)
+    assert lay.variables[-1].nominal == SCENE["cycloid.d_rrp"]
+
+
+@pytest.mark.parametrize("tol, match", [
+    (Tolerance("cycloid.d_rrp", tol=-1e-5), "'cycloid.d_rrp'.*>= 0"),
+    (Tolerance("cycloid.d_rrp", tol=float("nan")), "'cycloid.d_rrp'.*finite"),
+    (Tolerance("cycloid.d_rrp", lower=1e-5, upper=-1e-5), "'cycloid.d_rrp'.*negative"),
+    (Tolerance("cycloid.d_rrp", lower=0.0, upper=float("inf")), "'cycloid.d_rrp'.*finite"),
+    (Tolerance("cycloid.nonsense", tol=1e-5), "'cycloid.nonsense'"),
+    (Tolerance("crank_errors.eccentricity", tol=1e-5), "'crank_errors.eccentricity'"),
+    (Tolerance("cycloid.d_rrp", tol=1e-5, dist="triangular"), "dist"),
+    (Tolerance("name", tol=1.0), "'name'.*not numeric"),
+])
+def test_bad_tolerances_name_the_field(tol: Tolerance, match: str) -> None:
+    with pytest.raises(rvdyn.ParameterError, match=match):
+        rvdyn.study(SCENE, linear_metric, [tol], samples=2)
+
+
+def test_bad_correlations_are_errors() -> None:
+    with pytest.raises(rvdyn.ParameterError, match="not a toleranced path"):
+        expand(SCENE, TOLS, [Correlation(("cycloid.d_rrp", "cycloid.pin_radius"), rho=0.5)])
+    with pytest.raises(rvdyn.ParameterError, match="positive definite"):
+        expand(SCENE, TOLS, [Correlation(("cycloid.d_rrp", "cycloid.d_rp"), matrix=[[1, 2], [2, 1]])])
+    with pytest.raises(rvdyn.ParameterError, match="rho"):
+        expand(SCENE, TOLS, [Correlation(("cycloid.d_rrp", "cycloid.d_rp"), rho=1.0)])
+
+
+def test_bad_study_arguments_are_clear_errors() -> None:
+    with pytest.raises(rvdyn.ParameterError, match="unknown metric 'te'"):
+        rvdyn.study(SCENE, "dynamic", TOLS, samples=2, kernel_options=TINY, criteria=[Criterion("te", max=1.0)])
+    with pytest.raises(rvdyn.ParameterError, match="map"):
+        rvdyn.study(SCENE, linear_metric, TOLS, samples=2, runner=object())
+    with pytest.raises(rvdyn.ParameterError, match="'ltca'.*not available"):
+        rvdyn.study(SCENE, "ltca", TOLS, samples=2)
+    with pytest.raises(rvdyn.ParameterError, match="unknown kernel 'quasi'"):
+        rvdyn.study(SCENE, "quasi", TOLS, samples=2)
+    with pytest.raises(rvdyn.ParameterError, match="samples"):
+        rvdyn.study(SCENE, linear_metric, TOLS, samples=0)
+    with pytest.raises(rvdyn.ParameterError, match="seed"):
+        rvdyn.study(SCENE, linear_metric, TOLS, samples=2, seed=-1)
+    with pytest.raises(rvdyn.ParameterError, match="t_end"):
+        rvdyn.study(SCENE, "dynamic", TOLS, samples=2, kernel_options={"t_end": -1.0})
+    with pytest.raises(rvdyn.ParameterError, match="criterion on 'y'.*max"):
+        rvdyn.study(SCENE, FunctionKernel(linear_metric, ("y",)), TOLS, samples=2, criteria=[Criterion("y")])
+
+
+def test_unreachable_cluster_address_is_a_clear_error() -> None:
+    pytest.importorskip("distributed")
+    with pytest.raises(rvdyn.ParameterError, match="no Dask scheduler answers at 'tcp://127.0.0.1:1'"):
+        rvdyn.study(SCENE, linear_metric, TOLS, samples=2, runner="tcp://127.0.0.1:1",
+                    connect_timeout=1.0)
+
+
+# ----------------------------------------------------------------------------------- sampling
+def test_same_seed_same_design_and_band_convention() -> None:
+    lay = expand(SCENE, TOLS)
+    a, b = design(lay, MonteCarlo(20000), 7), design(lay, MonteCarlo(20000), 7)
+    assert np.array_equal(a, b) and not np.array_equal(a, design(lay, MonteCarlo(20000), 8))
+    # normal: band +-1e-5 = 6 sigma -> sigma = 1e-5 / 3; sample std within 4 standard errors
+    # (se of a std estimate ~ sigma / sqrt(2 n)).
+    sigma = 1e-5 / 3
+    assert abs(a[:, 0].std() - sigma) < 4 * sigma / math.sqrt(2 * 20000)
+    assert abs(a[:, 0].mean()) < 4 * sigma / math.sqrt(20000)
+    # uniform on [-2e-5, 0]
+    assert a[:, 1].min() >= -2e-5 and a[:, 1].max() <= 0.0
+
+
+def test_latin_hypercube_has_one_point_per_stratum() -> None:
+    lay = expand(SCENE, [Tolerance("cycloid.d_rp", lower=-2e-5, upper=0.0, dist="uniform"),
+                         Tolerance("cycloid.d_rrp", lower=0.0, upper=1e-5, dist="uniform")])
+    n = 50
+    x = design(lay, LatinHypercube(n), 3)
+    strata0 = np.floor((x[:, 0] + 2e-5) / 2e-5 * n).astype(int)
+    strata1 = np.floor(x[:, 1] / 1e-5 * n).astype(int)
+    assert sorted(strata0) == list(range(n)) and sorted(strata1) == list(range(n))
+
+
+def test_correlated_group_gaussian_copula() -> None:
+    lay = expand(SCENE, TOLS, [Correlation(("cycloid.d_rrp", "cycloid.d_rp"), rho=0.8)])
+    x = design(lay, MonteCarlo(40000), 1)
+    r = np.corrcoef(x.T)[0, 1]
+    # normal-uniform pair through a Gaussian copula: Pearson = rho * sqrt(3 / pi) (the uniform
+    # is Phi(z), cov(z, Phi(z)) = 1 / (2 sqrt(pi)), sd of Phi(z) = 1 / sqrt(12)).
+    expected = 0.8 * math.sqrt(3.0 / math.pi)
+    assert abs(r - expected) < 0.01  # se of r here ~ (1 - r^2) / sqrt(n) = 0.002
+
+
+# ------------------------------------------------------------------------------ runs and rows
+def test_dynamic_kernel_rows_inputs_and_metrics() -> None:
+    tols = [Tolerance("cycloid.d_rrp", tol=1e-5), Tolerance("pin_errors.radius", tol=5e-6, dist="uniform")]
+    t = rvdyn.study(SCENE, "dynamic", tols, samples=3, seed=2, runner=2, kernel_options=TINY)
+    assert list(t["sample"]) == [0, 1, 2]
+    assert set(rvdyn.study.DYNAMIC_METRICS) <= set(t.columns)
+    assert (t["error"] == "").all()
+    assert (t["peak_pin_force"] > 0).all() and (t["loaded_pins_min"] >= 1).all()
+    lay = expand(SCENE, tols)
+    assert np.array_equal(t[lay.columns].to_numpy(), design(lay, MonteCarlo(3), 2))
+    # the same sample run directly gives the same metrics
+    scene0 = SCENE.replace(**{"cycloid.d_rrp": float(t["cycloid.d_rrp"][0]),
+                              "pin_errors.radius": [float(t[f"pin_errors.radius.{i}"][0]) for i in range(24)]})
+    direct = rvdyn.study.DynamicKernel(0.01)(scene0)
+    assert direct["peak_pin_force"] == t["peak_pin_force"][0]
+
+
+def test_failed_samples_are_rows_with_their_error() -> None:
+    t = rvdyn.study(SCENE, failing_metric, TOLS, samples=20, seed=0, runner=2)
+    bad = t["cycloid.d_rrp"] > 0
+    assert len(t) == 20 and 0 < bad.sum() < 20
+    assert (t["error"][bad].str.contains("SimulationError: d_rrp > 0")).all()
+    assert t["y"][bad].isna().all() and (t["error"][~bad] == "").all()
+
+
+def test_numpy_table_without_pandas() -> None:
+    a = rvdyn.study(SCENE, linear_metric, TOLS, samples=5, seed=4, as_numpy=True)
+    df = rvdyn.study(SCENE, linear_metric, TOLS, samples=5, seed=4)
+    assert a.dtype.names == tuple(df.columns)
+    assert np.array_equal(a["y"], df["y"].to_numpy())
+
+
+def test_stream_to_parquet_and_resume(tmp_path: os.PathLike[str]) -> None:
+    pytest.importorskip("pyarrow")
+    out = os.path.join(tmp_path, "s.parquet")
+    kern = FunctionKernel(counting_metric, ("y",))
+    CALLS.clear()
+    full = rvdyn.study(SCENE, kern, TOLS, samples=10, seed=5, out=out, chunk_size=3, runner=1)
+    assert len(CALLS) == 10 and len(os.listdir(out)) == 1 + 4  # meta + 4 chunks
+    # Interrupted study: lose one chunk, run again: only its 3 samples run.
+    os.remove(os.path.join(out, "part-000001.parquet"))
+    CALLS.clear()
+    again = rvdyn.study(SCENE, kern, TOLS, samples=10, seed=5, out=out, chunk_size=3, runner=1)
+    assert len(CALLS) == 3
+    assert full.equals(again) and full.equals(rvdyn.study.read(out))
+    # Nothing left to do.
+    CALLS.clear()
+    rvdyn.study(SCENE, kern, TOLS, samples=10, seed=5, out=out, runner=1)
+    assert CALLS == []
+    with pytest.raises(rvdyn.ParameterError, match="different study"):
+        rvdyn.study(SCENE, kern, TOLS, samples=10, seed=6, out=out)
+
+
+def test_retry_failed_reruns_only_failed_samples(tmp_path: os.PathLike[str]) -> None:
+    pytest.importorskip("pyarrow")
+    out = os.path.join(tmp_path, "f.parquet")
+    t = rvdyn.study(SCENE, failing_metric, TOLS, samples=8, seed=0, out=out)
+    n_bad = int((t["error"] != "").sum())
+    assert n_bad > 0
+    CALLS.clear()
+    # Same study (same kernel id) with retry_failed: only failed ids are evaluated again.
+    t2 = rvdyn.study(SCENE, failing_metric, TOLS, samples=8, seed=0, out=out, retry_failed=True)
+    assert len(t2) == 8 and int((t2["error"] != "").sum()) == n_bad
+
+
+# ---------------------------------------------------------------------------------- statistics
+def test_yield_matches_the_wilson_interval() -> None:
+    y = np.array([0.1, 0.5, 0.9, 1.2, 0.3, 0.7, 2.0, 0.2, 0.95, 1.5])
+    table = {"sample": np.arange(10), "y": y, "error": np.array([""] * 10)}
+    res = rvdyn.study.yield_rate(table, [Criterion("y", max=1.0)])
+    k, n, z = 7, 10, 1.959963984540054
+    # Wilson (1927) score interval, closed form
+    centre = (k + z * z / 2) / (n + z * z)
+    half = z * math.sqrt(k * (n - k) / n + z * z / 4) / (n + z * z)
+    assert res.passed == 7 and res.rate.value == 0.7
+    assert math.isclose(res.rate.low, centre - half, rel_tol=1e-9)
+    assert math.isclose(res.rate.high, centre + half, rel_tol=1e-9)
+    exact = rvdyn.study.yield_rate(table, [{"metric": "y", "max": 1.0}], method="exact")
+    assert exact.rate.low < res.rate.low  # Clopper-Pearson is the more conservative here
+    with pytest.raises(rvdyn.ParameterError, match="unknown metric 'z'"):
+        rvdyn.study.yield_rate(table, [Criterion("z", max=1.0)])
+
+
+def test_src_ranks_a_linear_model_exactly() -> None:
+    t = rvdyn.study(SCENE, linear_metric, TOLS, samples=200, seed=9)
+    s = rvdyn.study.src(t, "y")
+    x1, x2, y = t["cycloid.d_rrp"], t["cycloid.d_rp"], t["y"]
+    # y = 3 x1 / 1e-5 + x2 / 1e-5 exactly: R^2 = 1 and SRC_i = b_i s_i / s_y.
+    assert s.r2 == pytest.approx(1.0, abs=1e-12)
+    assert s.names == ("cycloid.d_rrp", "cycloid.d_rp")
+    assert s.values[0] == pytest.approx(3e5 * x1.std() / y.std(), rel=1e-9)
+    assert s.values[1] == pytest.approx(1e5 * x2.std() / y.std(), rel=1e-9)
+
+
+def test_sobol_indices_of_an_additive_model() -> None:
+    pytest.importorskip("scipy", minversion="1.11")
+    s = rvdyn.study.sobol(SCENE, linear_metric, TOLS, 1024, "y", seed=3, runner=1)
+    # Additive model: S_i = a_i^2 var_i / sum a_j^2 var_j, normal sd 1e-5/3, uniform sd 2e-5/sqrt(12).
+    v1, v2 = (3.0 / 3) ** 2, (2.0 / math.sqrt(12)) ** 2
+    expected = {"cycloid.d_rrp": v1 / (v1 + v2), "cycloid.d_rp": v2 / (v1 + v2)}
+    assert s.names[0] == "cycloid.d_rrp"
+    for name, val, tot in zip(s.names, s.values, s.total):
+        assert abs(val - expected[name]) < 0.05 and abs(tot - expected[name]) < 0.05
+
+
+def test_describe_bootstrap_intervals() -> None:
+    t = rvdyn.study(SCENE, linear_metric, TOLS, samples=300, seed=1)
+    d = rvdyn.study.describe(t, n_resamples=500)["y"]
+    y = t["y"].to_numpy()
+    assert d["n"] == 300 and d["failed"] == 0
+    assert d["mean"].value == pytest.approx(y.mean()) and d["mean"].low < y.mean() < d["mean"].high
+    assert d["std"].value == pytest.approx(y.std(ddof=1)) and d["std"].low < d["std"].value < d["std"].high
+    assert d["p95"].value == pytest.approx(np.percentile(y, 95)) and d["p95"].low <= d["p95"].value <= d["p95"].high
+    # the mean's interval is close to the normal theory one: +- 1.96 s / sqrt(n), within 20 %
+    half = 1.96 * y.std(ddof=1) / math.sqrt(300)
+    assert abs((d["mean"].high - d["mean"].low) / (2 * half) - 1) < 0.2
+
+
+def test_plots_draw_criterion_and_bars() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = rvdyn.study(SCENE, linear_metric, TOLS, samples=50, seed=1)
+    ax = rvdyn.study.plot_histogram(t, "y", [Criterion("y", max=0.5)])
+    assert any(list(line.get_xdata()) == [0.5, 0.5] for line in ax.lines)
+    ax2 = rvdyn.study.plot_sensitivity(rvdyn.study.src(t, "y"))
+    assert len(ax2.patches) == 2
+    plt.close("all")
+
+
+# ------------------------------------------------------------------------------------------ CLI
+def test_cli_study_writes_table_statistics_and_plots(tmp_path: os.PathLike[str]) -> None:
+    pytest.importorskip("pyarrow")
+    spec = os.path.join(tmp_path, "spec.toml")
+    with open(spec, "w", encoding="utf-8") as f:
+        f.write("""
+[scene]
+preset = "rated"
+[kernel]
+name = "dynamic"
+t_end = 0.01
+[sampling]
+method = "lhs"
+samples = 4
+seed = 2
+[[tolerances]]
+path = "cycloid.d_rrp"
+tol = 1e-5
+[[tolerances]]
+path = "cycloid.d_rp"
+lower = -1e-5
+upper = 0.0
+dist = "uniform"
+[[criteria]]
+metric = "peak_pin_force"
+max = 1e9
+[runner]
+kind = "threads"
+workers = 2
+[output]
+dir = "out"
+""")
+    from rvdyn.cli import main
+
+    assert main(["study", spec]) == 0
+    out = os.path.join(tmp_path, "out")
+    assert os.path.getsize(os.path.join(out, "peak_pin_force.png")) > 0
+    with open(os.path.join(out, "statistics.json"), encoding="utf-8") as f:
+        stats = json.load(f)
+    assert stats["samples"] == 4 and stats["yield"]["passed"] == 4
+    assert len(rvdyn.study.read(os.path.join(out, "results.parquet"))) == 4
+    bad = os.path.join(tmp_path, "bad.toml")
+    with open(bad, "w", encoding="utf-8") as f:
+        f.write('[[tolerances]]\npath = "cycloid.d_rrp"\ntol = -1.0\n')
+    assert main(["study", bad]) == 1
+
+
+def test_statistics_of_a_numpy_table_match_the_dataframe() -> None:
+    a = rvdyn.study(SCENE, linear_metric, TOLS, samples=40, seed=2, as_numpy=True)
+    df = rvdyn.study(SCENE, linear_metric, TOLS, samples=40, seed=2)
+    assert rvdyn.study.src(a, "y") == rvdyn.study.src(df, "y")
+    crit = [Criterion("y", max=0.0)]
+    assert rvdyn.study.yield_rate(a, crit) == rvdyn.study.yield_rate(df, crit)
+    assert rvdyn.study.describe(a, n_resamples=100) == rvdyn.study.describe(df, n_resamples=100)
