@@ -195,6 +195,23 @@ def test_gap_with_another_pin_radius(paper_disc):
     assert gap == base.gap and rho == base.curvature_radius
 
 
+@pytest.mark.parametrize("d_rp", [-5e-4, -8e-4, -1e-3, -2e-3])
+def test_gap_of_pins_beyond_the_root_centre_of_curvature(d_rp):
+    # A shift modification of -0.8 mm leaves the pins at the roots 0.8 mm outside the pin-centre
+    # curve, beyond its 0.72 mm concave radius of curvature: the distance has two local minima
+    # on either side of the root. The gap is the smaller (against the NumPy brute force, 1e-11 m
+    # as above), and a run starts (both raised an error before).
+    g = rvdyn.CycloidGeometry(ZP, E, RP, RRP, FACE, d_rp=d_rp)
+    for psi, j in [(0.0, 0), (0.3, 0), (1.0, 5)]:
+        centre, angle = g.kinematic_pose(psi)
+        exact = g.gap(pin_centre(j), centre, angle)
+        brute, _ = brute_force_gap(g, pin_centre(j), centre, angle)
+        assert abs(exact.gap - brute) < 1e-11, (exact.gap, brute)
+        assert exact.gap > 0.0
+    r = rvdyn.simulate(rvdyn.Scene.paper("idle", **{"cycloid.d_rp": d_rp}), 2e-3)
+    assert np.all(np.isfinite(r.pin_force))
+
+
 def test_modifications_open_the_first_order_clearance():
     # docs/validation.md: g0(phi) = d_rrp - d_rp (1 - K1 cos phi)/S at the kinematic pose,
     # phi the pin angle from the eccentricity direction. The exact gap differs at second order:

@@ -105,7 +105,8 @@ def test_options_are_validated_once_and_recorded() -> None:
     assert r.options["integrator"] == "rk4" and r.options["t_end"] == 1e-3
     assert r.options["dt"] == pytest.approx(1e-3 / 34)  # ceil(1e-3 / 3e-5) = 34 equal steps
     assert isinstance(r.stats["steps"], int) and r.stats["steps"] == 34
-    assert rvdyn.INTEGRATORS[0] == "generalized-alpha" and set(rvdyn.INTEGRATORS) == {"generalized-alpha", "dopri5", "rk4"}
+    assert rvdyn.INTEGRATORS[0] == "generalized-alpha" and set(rvdyn.INTEGRATORS) == {
+        "generalized-alpha", "generalized-alpha-adaptive", "dopri5", "rk4"}
 
 
 def test_result_save_load_keeps_options_and_never_unpickles(tmp_path: Path) -> None:

@@ -32,6 +32,9 @@ import numpy as np
 import pytest
 
 hypothesis = pytest.importorskip("hypothesis")
+# A fixed step too long for the pin mesh is reported as a RuntimeWarning (not an error): the
+# hostile options draw such steps on purpose.
+pytestmark = pytest.mark.filterwarnings("ignore:.*pin-mesh period:RuntimeWarning")
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 from hypothesis.extra import numpy as hnp  # noqa: E402

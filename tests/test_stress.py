@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -46,17 +47,21 @@ class Case:
     energy_tol: float = 0.05
     #: For expected errors: a phrase the message must contain (the advice).
     advice: str = "reduce"
+    #: Whether the fixed-step check must warn that the step cannot be accurate.
+    warns: bool = False
 
 
 CASES = [
     Case("default, step start from rest", {}, 0.5),
-    # Far softer contacts at the rated 35 kN pin load mean approaches near the 0.72 mm concave
-    # radius of the root, where a rigid-profile penalty model stops being meaningful: the run
-    # must stop with advice to raise the stiffness. At lower loads the same laws run.
+    # Far softer contacts at the rated 35 kN pin load mean approaches beyond the physical bound
+    # (a tenth of the pin radius): the run must stop with advice to raise the stiffness. At
+    # x0.1 the approach stays below it (0.88 mm); that run used to stop with a false "exact gap
+    # not found" once unloaded pins sat beyond the root's 0.72 mm centre of curvature (issue 12
+    # D5). At lower loads the same laws run.
     Case("contact stiffness x0.01, rated load", {"contact.pin": law(K * 0.01), "contact.mesh": law(K * 0.01)},
          0.5, expect="error", advice="too soft"),
     Case("contact stiffness x0.1, rated load", {"contact.pin": law(K * 0.1), "contact.mesh": law(K * 0.1)},
-         0.5, expect="error", advice="too soft"),
+         0.5),
     Case("contact stiffness x0.1, paper load", {"contact.pin": law(K * 0.1), "contact.mesh": law(K * 0.1)},
          0.5, load="paper"),
     Case("contact stiffness x0.01, idle", {"contact.pin": law(K * 0.01), "contact.mesh": law(K * 0.01)},
@@ -87,8 +92,9 @@ CASES = [
     Case("rk4 at dt = 1e-5 (inside its limit)", {}, 0.2, "rk4", {"dt": 1e-5}),
     Case("rk4 at dt = 5e-4 (beyond its limit)", {}, 0.2, "rk4", {"dt": 5e-4}, expect="error"),
     Case("dopri5 at atol = 1e-6 m (loose)", {}, 0.2, "dopri5", {"atol": 1e-6}),
-    Case("generalized-alpha at dt = 1e-3 (10x default)", {}, 0.5, options={"dt": 1e-3}),
-    Case("generalized-alpha at dt = 5e-3 (50x default)", {}, 0.5, options={"dt": 5e-3}),
+    # Fewer than 8 steps per 4.46 ms pin-mesh period: they run, with a warning.
+    Case("generalized-alpha at dt = 1e-3 (10x default)", {}, 0.5, options={"dt": 1e-3}, warns=True),
+    Case("generalized-alpha at dt = 5e-3 (50x default)", {}, 0.5, options={"dt": 5e-3}, warns=True),
     Case("generalized-alpha, rho_inf = 1 (no numerical damping)", {}, 0.5, options={"rho_inf": 1.0}),
 ]
 
@@ -109,12 +115,15 @@ def run_case(case: Case) -> dict[str, Any]:
     scene = build_scene(case)
     start = time.perf_counter()
     try:
-        res = simulate(scene, case.t_end, case.integrator, **case.options)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", RuntimeWarning)
+            res = simulate(scene, case.t_end, case.integrator, **case.options)
     except rvdyn.SimulationError as exc:
         return {"case": case.name, "outcome": "SimulationError", "message": str(exc),
                 "wall": time.perf_counter() - start}
     wall = time.perf_counter() - start
-    row: dict[str, Any] = {"case": case.name, "outcome": "ok", "wall": wall}
+    row: dict[str, Any] = {"case": case.name, "outcome": "ok", "wall": wall,
+                           "warnings": [str(w.message) for w in caught if w.category is RuntimeWarning]}
     row["finite"] = bool(all(np.all(np.isfinite(getattr(res, c))) for c in res.channels))
     row["max_penetration"] = float(res.pin_penetration.max())
     row["peak_pin_force"] = float(res.pin_force.max())
@@ -133,6 +142,9 @@ def check(case: Case, row: dict[str, Any]) -> None:
         return
     assert row["outcome"] == "ok", row.get("message")
     assert row["finite"]
+    # The fixed-step check warns exactly where the step cannot resolve the pin mesh.
+    assert bool(row["warnings"]) == case.warns, row["warnings"]
+    assert all("pin-mesh period" in w for w in row["warnings"])
     # Penetration bounded: far below the 1 mm bound (the largest elastic approach of the paper's
     # law at 10x the rated pin force is 0.9 mm; at the rated load it is 0.2 mm).
     assert row["max_penetration"] < 0.9e-3

@@ -356,12 +356,14 @@ def default_compliant_joints() -> str:
 class Options:
     """Options of a dynamic run (all but the end time), validated when built; None = default.
 
-    integrator: "generalized-alpha" (default), "dopri5" or "rk4"; dt [s] (None = the
-    integrator's default: 1e-4, 1e-6 (initial), 1e-5 s); rtol (adaptive, velocities, default
-    1e-6); atol [m] (displacement tolerance, default 1e-9 m); rho_inf in [0, 1] (default 0.8);
-    record_interval [s] (None = 1e-4 s); max_samples (default 50 000); channels (groups:
-    "motion", "pins", "contact_points", "mesh", "energy", "bearings"; None = all but contact points);
-    skip_separated (default True).
+    integrator: "generalized-alpha" (default), "generalized-alpha-adaptive", "dopri5" or "rk4";
+    dt [s] (None = the integrator's default: 1e-4, 1e-5 (initial), 1e-6 (initial), 1e-5 s);
+    rtol (adaptive, velocities, default 1e-6); atol [m] (displacement tolerance, default
+    1e-9 m); rho_inf in [0, 1] (default 0.8); record_interval [s] (None = 1e-4 s); max_samples
+    (default 50 000); channels (groups: "motion", "pins", "contact_points", "mesh", "energy",
+    "bearings"; None = all but contact points); skip_separated (default True); step_check
+    ("warn", "raise" or "off": a fixed step that cannot be accurate, default "warn"); h_min [s]
+    and max_steps (bounds of an adaptive method, default 1e-13 s and 1e8).
     """
 
     def __new__(
@@ -376,6 +378,9 @@ class Options:
         max_samples: int | None = None,
         channels: Sequence[str] | str | None = None,
         skip_separated: bool | None = None,
+        step_check: str | None = None,
+        h_min: float | None = None,
+        max_steps: int | None = None,
     ) -> Options: ...
     def replace(
         self,
@@ -389,6 +394,9 @@ class Options:
         max_samples: int | None = None,
         channels: Sequence[str] | str | None = None,
         skip_separated: bool | None = None,
+        step_check: str | None = None,
+        h_min: float | None = None,
+        max_steps: int | None = None,
     ) -> Options:
         """A copy with the options given (not None) changed."""
     @property
@@ -418,6 +426,15 @@ class Options:
     @property
     def skip_separated(self) -> bool:
         """Whether pins that provably cannot touch skip the exact gap query."""
+    @property
+    def step_check(self) -> str:
+        """What a fixed step that cannot be accurate does: "warn", "raise" or "off"."""
+    @property
+    def h_min(self) -> float:
+        """Smallest step of an adaptive method [s]."""
+    @property
+    def max_steps(self) -> int:
+        """Most steps of an adaptive method."""
     def to_dict(self) -> dict[str, Any]:
         """The options as a dict of constructor arguments."""
     def resolved(self, t_end: float) -> dict[str, Any]:

@@ -11,6 +11,7 @@ import itertools
 import json
 import operator
 import sys
+import warnings
 from typing import Any, Iterable, Mapping, Sequence
 
 from . import _core
@@ -44,6 +45,13 @@ def _resolve_options(options: Options | None, integrator: str | None, changes: d
     return options.replace(**given) if given else options
 
 
+def _warn(stats: dict[str, Any]) -> None:
+    """Issue the run's accuracy warnings (a fixed step too long for the scene) as
+    ``RuntimeWarning`` and keep them out of the numeric statistics."""
+    for message in stats.pop("warnings", []):
+        warnings.warn(message, RuntimeWarning, stacklevel=3)
+
+
 def _t_end(t_end: object) -> float:
     try:
         return float(t_end)  # type: ignore[arg-type]
@@ -55,13 +63,16 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
              dt: float | None = None, rtol: float | None = None, atol: float | None = None,
              rho_inf: float | None = None, record_interval: float | None = None, max_samples: int | None = None,
              channels: Sequence[str] | str | None = None, progress: bool | None = None,
-             skip_separated: bool | None = None) -> Result:
+             skip_separated: bool | None = None, step_check: str | None = None,
+             h_min: float | None = None, max_steps: int | None = None) -> Result:
     """Simulate ``scene`` from t = 0 to ``t_end`` [s] and return the recorded :class:`Result`.
 
     options: an :class:`rvdyn.Options`; the keyword arguments below, when given, change it.
     integrator: ``"generalized-alpha"`` (implicit, order 2, fixed step ``dt``, default 1e-4 s;
     ``rho_inf`` in [0, 1] sets its high-frequency damping, default 0.8; ``atol`` [m] is its
-    Newton tolerance on displacements, default 1e-9 m), ``"dopri5"``
+    Newton tolerance on displacements, default 1e-9 m), ``"generalized-alpha-adaptive"`` (the
+    same method with its step chosen for ``atol`` [m] and ``rtol``: local error estimate, PI
+    controller, initial step ``dt``, default 1e-5 s), ``"dopri5"``
     (adaptive Dormand-Prince 5(4); ``atol`` [m] bounds displacement errors, default 1e-9 m;
     ``rtol`` relative velocity tolerance, default 1e-6) or ``"rk4"`` (fixed step ``dt``,
     default 1e-5 s).
@@ -74,6 +85,11 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     skip_separated: skip the exact gap query of pins that provably cannot touch (a Lipschitz
     bound on the gap from the last exact query and the disc's motion since); the answer is the
     same either way, ``False`` exists to measure the saving.
+    step_check: what a fixed step that cannot be accurate for the scene does (fewer than 8 steps
+    per pin-mesh period): ``"warn"`` (default, a ``RuntimeWarning``), ``"raise"``
+    (:class:`rvdyn.ParameterError`) or ``"off"``.
+    h_min, max_steps: smallest step [s] (default 1e-13 s) and most steps (default 1e8) of an
+    adaptive integrator; beyond either the run stops with :class:`rvdyn.SimulationError`.
 
     The core runs with the GIL released; Ctrl-C stops it cleanly (``KeyboardInterrupt``). A run
     that goes unstable raises :class:`rvdyn.SimulationError` saying when and what would help.
@@ -85,12 +101,14 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     scene = _check_scene(scene)
     opts = _resolve_options(options, integrator, {
         "dt": dt, "rtol": rtol, "atol": atol, "rho_inf": rho_inf, "record_interval": record_interval,
-        "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated})
+        "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated,
+        "step_check": step_check, "h_min": h_min, "max_steps": max_steps})
     t = _t_end(t_end)
     if progress is None:
         progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
     used = opts.resolved(t)
     arrays, stats = _core.simulate(scene._compiled, t, opts, progress=bool(progress))
+    _warn(stats)
     return Result(arrays, stats, scene.to_dict(), used)
 
 
@@ -110,7 +128,8 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
           threads: int | None = None, dt: float | None = None, rtol: float | None = None,
           atol: float | None = None, rho_inf: float | None = None, record_interval: float | None = None,
           max_samples: int | None = None, channels: Sequence[str] | str | None = None,
-          skip_separated: bool | None = None) -> list[Result]:
+          skip_separated: bool | None = None, step_check: str | None = None,
+          h_min: float | None = None, max_steps: int | None = None) -> list[Result]:
     """Run many scenes in parallel (Rust threads, GIL released) and return one :class:`Result`
     per scene, in order. A run that failed has ``ok`` False and its exception in ``error``
     (a failed run does not stop the others); bad options raise before any run, as for
@@ -136,7 +155,8 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
         points = [{} for _ in scene_list]
     opts = _resolve_options(options, integrator, {
         "dt": dt, "rtol": rtol, "atol": atol, "rho_inf": rho_inf, "record_interval": record_interval,
-        "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated})
+        "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated,
+        "step_check": step_check, "h_min": h_min, "max_steps": max_steps})
     t = _t_end(t_end)
     used = opts.resolved(t)
     if threads is not None:
@@ -157,5 +177,6 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
             out.append(Result.failed(error, scene.to_dict(), run_options))
         else:
             arrays, stats = item
+            _warn(stats)
             out.append(Result(arrays, stats, scene.to_dict(), run_options))
     return out

@@ -2,7 +2,7 @@
 //! Python `rvdyn.simulate`, `rvdyn.sweep` and `rvdyn.Result` (python/rvdyn/) wrap these.
 
 use super::scene::CompiledScene;
-use crate::dynamics::run::driver::{RunControl, SimOptions};
+use crate::dynamics::run::driver::{RunControl, SimOptions, StepCheck};
 use crate::dynamics::run::recorder::{CHANNELS, Channel, Dtype, Recording};
 use crate::dynamics::scene::Scene;
 use crate::error::RvdynError;
@@ -81,10 +81,24 @@ fn set_option(o: &mut SimOptions, key: &str, value: &Bound<'_, PyAny>) -> PyResu
         "skip_separated" => {
             o.skip_separated = value.is_truthy()?;
         }
+        "step_check" => {
+            let name: String = value.extract().map_err(|_| {
+                crate::python::parameter_error("step_check must be \"warn\", \"raise\" or \"off\"")
+            })?;
+            o.step_check = StepCheck::parse(&name)?;
+        }
+        "h_min" => o.h_min = float("s")?,
+        "max_steps" => {
+            let n: i64 = value.extract().map_err(|_| {
+                crate::python::parameter_error("max_steps must be a whole number >= 1")
+            })?;
+            o.max_steps = u64::try_from(n).unwrap_or(0);
+        }
         _ => {
             return Err(crate::python::parameter_error(format!(
                 "unknown option {key:?}: the options are integrator, dt, rtol, atol, rho_inf, \
-                 record_interval, max_samples, channels, skip_separated"
+                 record_interval, max_samples, channels, skip_separated, step_check, h_min, \
+                 max_steps"
             )));
         }
     }
@@ -129,7 +143,8 @@ impl Options {
 impl Options {
     #[new]
     #[pyo3(signature = (integrator = None, *, dt = None, rtol = None, atol = None, rho_inf = None,
-        record_interval = None, max_samples = None, channels = None, skip_separated = None))]
+        record_interval = None, max_samples = None, channels = None, skip_separated = None,
+        step_check = None, h_min = None, max_steps = None))]
     #[allow(clippy::too_many_arguments)]
     fn py_new<'py>(
         py: Python<'py>,
@@ -142,6 +157,9 @@ impl Options {
         max_samples: Option<Bound<'py, PyAny>>,
         channels: Option<Bound<'py, PyAny>>,
         skip_separated: Option<Bound<'py, PyAny>>,
+        step_check: Option<Bound<'py, PyAny>>,
+        h_min: Option<Bound<'py, PyAny>>,
+        max_steps: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Self> {
         let given = given(
             py,
@@ -155,6 +173,9 @@ impl Options {
                 ("max_samples", max_samples),
                 ("channels", channels),
                 ("skip_separated", skip_separated),
+                ("step_check", step_check),
+                ("h_min", h_min),
+                ("max_steps", max_steps),
             ],
         )?;
         apply(SimOptions::new(1.0, Method::GeneralizedAlpha), Some(&given))
@@ -162,7 +183,8 @@ impl Options {
 
     /// A copy with the options given (not None) changed; same names as the constructor.
     #[pyo3(signature = (*, integrator = None, dt = None, rtol = None, atol = None, rho_inf = None,
-        record_interval = None, max_samples = None, channels = None, skip_separated = None))]
+        record_interval = None, max_samples = None, channels = None, skip_separated = None,
+        step_check = None, h_min = None, max_steps = None))]
     #[allow(clippy::too_many_arguments)]
     fn replace<'py>(
         &self,
@@ -176,6 +198,9 @@ impl Options {
         max_samples: Option<Bound<'py, PyAny>>,
         channels: Option<Bound<'py, PyAny>>,
         skip_separated: Option<Bound<'py, PyAny>>,
+        step_check: Option<Bound<'py, PyAny>>,
+        h_min: Option<Bound<'py, PyAny>>,
+        max_steps: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Self> {
         let given = given(
             py,
@@ -189,6 +214,9 @@ impl Options {
                 ("max_samples", max_samples),
                 ("channels", channels),
                 ("skip_separated", skip_separated),
+                ("step_check", step_check),
+                ("h_min", h_min),
+                ("max_steps", max_steps),
             ],
         )?;
         apply(self.inner.clone(), Some(&given))
@@ -239,6 +267,25 @@ impl Options {
     fn skip_separated(&self) -> bool {
         self.inner.skip_separated
     }
+    /// What a fixed step that cannot be accurate does: "warn", "raise" or "off".
+    #[getter]
+    fn step_check(&self) -> &'static str {
+        match self.inner.step_check {
+            StepCheck::Warn => "warn",
+            StepCheck::Raise => "raise",
+            StepCheck::Off => "off",
+        }
+    }
+    /// Smallest step of an adaptive method [s].
+    #[getter]
+    fn h_min(&self) -> f64 {
+        self.inner.h_min
+    }
+    /// Most steps of an adaptive method.
+    #[getter]
+    fn max_steps(&self) -> u64 {
+        self.inner.max_steps
+    }
 
     /// The options as a dict (constructor names; `Options(**d)` rebuilds them).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -252,6 +299,9 @@ impl Options {
         d.set_item("max_samples", self.max_samples())?;
         d.set_item("channels", self.channels())?;
         d.set_item("skip_separated", self.skip_separated())?;
+        d.set_item("step_check", self.step_check())?;
+        d.set_item("h_min", self.h_min())?;
+        d.set_item("max_steps", self.max_steps())?;
         Ok(d)
     }
 
@@ -285,7 +335,8 @@ impl Options {
         let opt = |v: Option<f64>| v.map_or("None".to_string(), |x| format!("{x:?}"));
         format!(
             "Options(integrator='{}', dt={}, rtol={:?}, atol={:?}, rho_inf={:?}, \
-             record_interval={}, max_samples={}, channels=[{}], skip_separated={})",
+             record_interval={}, max_samples={}, channels=[{}], skip_separated={}, \
+             step_check='{}', h_min={:?}, max_steps={})",
             o.method.name(),
             opt(o.dt),
             o.rtol,
@@ -298,7 +349,10 @@ impl Options {
                 .map(|c| format!("'{c}'"))
                 .collect::<Vec<_>>()
                 .join(", "),
-            if o.skip_separated { "True" } else { "False" }
+            if o.skip_separated { "True" } else { "False" },
+            self.step_check(),
+            o.h_min,
+            o.max_steps
         )
     }
 }
@@ -372,6 +426,7 @@ fn to_python<'py>(
     }
     stats.set_item("dt", rec.stats.dt)?;
     stats.set_item("wall_time", wall_time)?;
+    stats.set_item("warnings", rec.warnings)?;
     Ok((arrays, stats))
 }
 

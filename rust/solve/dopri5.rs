@@ -17,7 +17,12 @@ pub static ENTRY: IntegratorEntry = IntegratorEntry {
     default_dt: 1e-6,
     adaptive: true,
     summary: "Dormand-Prince 5(4), explicit, adaptive step with error control on displacements",
-    build: |s: &Settings| Ok(Box::new(Dopri5::new(s.rtol, s.atol, s.dt, s.h_max))),
+    build: |s: &Settings| {
+        let mut d = Dopri5::new(s.rtol, s.atol, s.dt, s.h_max);
+        d.h_min = s.h_min;
+        d.max_steps = s.max_steps;
+        Ok(Box::new(d))
+    },
 };
 
 /// Time over which a velocity error is turned into a displacement error [s].
@@ -100,6 +105,8 @@ pub struct Dopri5 {
     pub h_min: f64,
     /// Largest step [s].
     pub h_max: f64,
+    /// Most accepted steps before the run is declared failed.
+    pub max_steps: u64,
     /// Accepted steps.
     pub accepted: u64,
     /// Rejected tries.
@@ -128,6 +135,7 @@ impl Dopri5 {
             h: h0,
             h_min: 1e-13,
             h_max,
+            max_steps: u64::MAX,
             accepted: 0,
             rejected: 0,
             kq: Default::default(),
@@ -301,6 +309,14 @@ impl Dopri5 {
 
 impl Integrator for Dopri5 {
     fn advance(&mut self, sys: &dyn MechanicalSystem, st: &mut State, t_end: f64) -> Result<()> {
+        if self.accepted >= self.max_steps {
+            return Err(RvdynError::Simulation(format!(
+                "dopri5 needed more than max_steps = {} steps to reach t = {t_end:.6e} s \
+                 (stopped at t = {:.6e} s): loosen atol/rtol, raise max_steps, or use \
+                 integrator=\"generalized-alpha-adaptive\" if the steps are limited by stability",
+                self.max_steps, st.t
+            )));
+        }
         self.step(sys, st, t_end)
     }
 

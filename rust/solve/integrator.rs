@@ -23,6 +23,10 @@ pub struct Settings {
     pub rho_inf: f64,
     /// Largest step an adaptive method may take [s].
     pub h_max: f64,
+    /// Smallest step an adaptive method may take [s] (below it the run fails).
+    pub h_min: f64,
+    /// Most steps an adaptive method may take (beyond it the run fails).
+    pub max_steps: u64,
     /// Whether the work integrals (energy channel) are wanted.
     pub track_work: bool,
 }
@@ -65,6 +69,7 @@ pub struct IntegratorEntry {
 /// Every integrator known by name. Add a line here to register a new one.
 pub static INTEGRATORS: &[&IntegratorEntry] = &[
     &crate::solve::generalized_alpha::ENTRY,
+    &crate::solve::adaptive_alpha::ENTRY,
     &crate::solve::dopri5::ENTRY,
     &crate::solve::rk4::ENTRY,
 ];

@@ -10,6 +10,7 @@
 
 #![warn(missing_docs)]
 
+pub mod adaptive_alpha;
 pub mod dopri5;
 pub mod generalized_alpha;
 pub mod integrator;

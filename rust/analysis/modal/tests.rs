@@ -302,11 +302,13 @@ fn compliant_scene(k_ecc: f64, k_crank: Option<f64>) -> Scene {
             stiffness: k_ecc,
             damping: 1e4,
             clearance: 0.0,
+            rollers: None,
         },
         crank_bearing: k_crank.map(|k| Bearing {
             stiffness: k,
             damping: 1e4,
             clearance: 0.0,
+            rollers: None,
         }),
     };
     s

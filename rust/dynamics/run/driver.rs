@@ -40,6 +40,38 @@ pub struct SimOptions {
     pub channels: Vec<Channel>,
     /// Skip the exact query of pins that provably cannot touch (exact: same answer).
     pub skip_separated: bool,
+    /// What a fixed step that cannot be accurate does: warn (default), raise, or nothing.
+    pub step_check: StepCheck,
+    /// Smallest step of an adaptive method [s]; below it the run fails.
+    pub h_min: f64,
+    /// Most steps an adaptive method may take; beyond it the run fails.
+    pub max_steps: u64,
+}
+
+/// What [`simulate`] does about a fixed step that cannot be accurate for the scene
+/// (see [`fixed_step_warnings`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepCheck {
+    /// Run, and report the warnings in [`Recording::warnings`].
+    Warn,
+    /// Fail with a `Parameter` error instead of running.
+    Raise,
+    /// No check.
+    Off,
+}
+
+impl StepCheck {
+    /// Parse `"warn"`, `"raise"` or `"off"`.
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "warn" => Ok(Self::Warn),
+            "raise" => Ok(Self::Raise),
+            "off" => Ok(Self::Off),
+            _ => Err(RvdynError::Parameter(format!(
+                "step_check must be \"warn\", \"raise\" or \"off\", got {name:?}"
+            ))),
+        }
+    }
 }
 
 impl SimOptions {
@@ -56,6 +88,9 @@ impl SimOptions {
             max_samples: 50_000,
             channels: Channel::defaults(),
             skip_separated: true,
+            step_check: StepCheck::Warn,
+            h_min: 1e-13,
+            max_steps: 100_000_000,
         }
     }
 
@@ -73,7 +108,10 @@ impl SimOptions {
             rtol: self.rtol,
             atol: self.atol,
             rho_inf: self.rho_inf,
-            h_max: self.sample_interval().max(dt),
+            // Samples are interpolated (cubic Hermite), so they do not bound the step.
+            h_max: self.t_end,
+            h_min: self.h_min,
+            max_steps: self.max_steps,
             track_work: self.channels.contains(&Channel::Energy),
         }
     }
@@ -144,6 +182,15 @@ impl SimOptions {
                 self.max_samples
             ));
         }
+        if !(self.h_min.is_finite() && self.h_min > 0.0) {
+            return bad(format!(
+                "h_min must be a step > 0 s, got {}: e.g. 1e-13 s",
+                self.h_min
+            ));
+        }
+        if self.max_steps == 0 {
+            return bad("max_steps must be at least 1".into());
+        }
         Ok(())
     }
 
@@ -188,14 +235,72 @@ pub fn simulate(scene: &Scene, options: &SimOptions, control: &RunControl) -> Re
         Joints::Rigid => {
             let mut model = RigidModel::new(scene)?;
             model.skip_separated = options.skip_separated;
-            run(&RigidSystem::new(&model), options, control)
+            checked_run(scene, &RigidSystem::new(&model), options, control)
         }
         Joints::Compliant { .. } => {
             let mut model = crate::dynamics::model::compliant::CompliantModel::new(scene)?;
             model.skip_separated = options.skip_separated;
-            run(&model, options, control)
+            checked_run(scene, &model, options, control)
         }
     }
+}
+
+/// [`run`] after the fixed-step check of `options.step_check`.
+fn checked_run<M: ReducerModel>(
+    scene: &Scene,
+    sys: &M,
+    options: &SimOptions,
+    control: &RunControl,
+) -> Result<Recording> {
+    let warnings = match options.step_check {
+        StepCheck::Off => Vec::new(),
+        check => {
+            let w = fixed_step_warnings(scene, options)?;
+            if check == StepCheck::Raise && !w.is_empty() {
+                return Err(RvdynError::Parameter(w.join("; ")));
+            }
+            w
+        }
+    };
+    let mut rec = run(sys, options, control)?;
+    rec.warnings = warnings;
+    Ok(rec)
+}
+
+/// Steps per pin-mesh period below which a fixed step is reported: at 8 the pin forces of the
+/// paper scenes are off by about 0.1 % of their peak (BENCHMARKS.md, work-precision).
+pub const STEPS_PER_MESH_PERIOD: f64 = 8.0;
+
+/// Why a fixed step `dt` cannot be accurate for `scene`, if it cannot (empty for an adaptive
+/// method): fewer than [`STEPS_PER_MESH_PERIOD`] steps per pin-mesh period
+/// `2 pi |i| / (zp zc w_in)` (docs/model.md, pin-pass frequency; a prescribed input speed `w_in`
+/// only). The pin pass is the highest frequency that excites the model (the sun/planet mesh
+/// stiffness is constant); the linearised modes above it respond quasi-statically, and
+/// generalized-alpha damps them (an explicit method's step is bounded by them instead: the
+/// RK4 stability check, dopri5's stiffness detection).
+pub fn fixed_step_warnings(scene: &Scene, opt: &SimOptions) -> Result<Vec<String>> {
+    if opt.method.0.adaptive {
+        return Ok(Vec::new());
+    }
+    let dt = opt.settings().dt;
+    let name = opt.method.name();
+    let mut out = Vec::new();
+    if let crate::dynamics::scene::Drive::Speed { speed, .. } = scene.drive {
+        let zp = f64::from(scene.cycloid.pins);
+        let period =
+            2.0 * std::f64::consts::PI * scene.ratio().abs() / (zp * (zp - 1.0) * speed.abs());
+        if period.is_finite() && dt * STEPS_PER_MESH_PERIOD > period {
+            out.push(format!(
+                "{name} with dt = {dt:.3e} s takes {:.1} steps per pin-mesh period ({:.3e} s at \
+                 the input speed): the pin forces can be off by more than 0.1 % of their peak; \
+                 use dt <= {:.1e} s or integrator=\"generalized-alpha-adaptive\"",
+                period / dt,
+                period,
+                period / STEPS_PER_MESH_PERIOD
+            ));
+        }
+    }
+    Ok(out)
 }
 
 /// Integrate a built model with the integrator named in the options.

@@ -371,6 +371,8 @@ pub struct Recording {
     pub samples: usize,
     /// Integrator statistics: steps, force evaluations, Jacobians, rejected or split steps.
     pub stats: Stats,
+    /// Why the run may be inaccurate (see `driver::fixed_step_warnings`).
+    pub warnings: Vec<String>,
 }
 
 /// Collects the contacts of one evaluation into per-sample buffers.
@@ -495,6 +497,7 @@ impl Recorder {
                 series,
                 samples: 0,
                 stats: Stats::default(),
+                warnings: Vec::new(),
             },
             sink,
             nd,

@@ -1,0 +1,96 @@
+"""The error-controlled generalized-alpha, interpolated output and the fixed-step check
+(issue 13). Tolerances are stated where used, with the reason."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import rvdyn
+from rvdyn import Scene, simulate
+
+T = 0.05  # span of the short runs [s]: the start impact and 2 pin-mesh periods after it
+
+
+@pytest.fixture(scope="module")
+def reference() -> rvdyn.Result:
+    return simulate(Scene.paper("rated"), T, "dopri5", atol=1e-13, rtol=1e-11, channels=["motion", "pins"])
+
+
+def pin_error(r: rvdyn.Result, ref: rvdyn.Result) -> float:
+    w = ref.t >= 0.5 * T
+    return float(np.abs(r.pin_force[w] - ref.pin_force[w]).max() / ref.pin_force[w].max())
+
+
+def test_adaptive_error_falls_with_the_tolerance(reference: rvdyn.Result) -> None:
+    errors, steps = [], []
+    for atol in (1e-7, 1e-8, 1e-9):
+        r = simulate(Scene.paper("rated"), T, "generalized-alpha-adaptive", atol=atol, rtol=1e3 * atol,
+                     channels=["motion", "pins"])
+        assert r.ok and r.options["integrator"] == "generalized-alpha-adaptive"
+        errors.append(pin_error(r, reference))
+        steps.append(r.stats["steps"])
+    # Each decade of tolerance buys at least a factor 3 in pin-force error (the method is
+    # second order with error-per-unit-step control: about 10 asymptotically), for more steps.
+    assert errors[0] > 3 * errors[1] > 9 * errors[2], errors
+    assert steps[0] < steps[1] < steps[2], steps
+    # At 1e-9 m the pin forces are within 1e-4 of their peak (measured 2e-6 on 0.5 s).
+    assert errors[2] < 1e-4, errors
+
+
+@pytest.mark.parametrize("integrator", ["generalized-alpha-adaptive", "dopri5"])
+def test_samples_do_not_bound_the_adaptive_step(integrator: str) -> None:
+    # Samples are interpolated between steps: the steps taken do not depend on the sample
+    # interval (dopri5 took about 3 times more steps with samples every 0.1 ms before).
+    runs = [simulate(Scene.paper("rated"), 0.02, integrator, record_interval=ri, channels=["motion"])
+            for ri in (1e-5, 1e-3)]
+    assert runs[0].stats["steps"] == runs[1].stats["steps"]
+    assert runs[0].t.size == 2001 and runs[1].t.size == 21
+    # The coarse samples are the fine ones at the same times (same steps, same interpolation).
+    np.testing.assert_allclose(runs[0].carrier_speed[::100], runs[1].carrier_speed, rtol=0, atol=1e-12)
+
+
+def test_a_fixed_step_too_long_for_the_pin_mesh_warns_or_raises() -> None:
+    s = Scene.paper("rated")
+    # 4.46 ms pin-mesh period at 8328 deg/s: 1 ms is 4.5 steps per period, below 8.
+    with pytest.warns(RuntimeWarning, match=r"4\.5 steps per pin-mesh period \(4\.464e-3 s"):
+        r = simulate(s, 2e-3, dt=1e-3)
+    assert r.ok and "warnings" not in r.stats
+    with pytest.raises(rvdyn.ParameterError, match="pin-mesh period"):
+        simulate(s, 2e-3, dt=1e-3, step_check="raise")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        simulate(s, 2e-3, dt=1e-3, step_check="off")
+        simulate(s, 2e-3, dt=5e-4)  # 8.9 steps per period: no warning
+        simulate(s, 2e-3, "generalized-alpha-adaptive")  # adaptive: not checked
+    with pytest.raises(rvdyn.ParameterError, match="step_check"):
+        simulate(s, 2e-3, step_check="loud")
+
+
+@pytest.mark.parametrize("bad", [
+    {"atol": 0.0}, {"atol": math.nan}, {"atol": -1e-9}, {"rtol": math.inf}, {"rtol": -1.0},
+    {"h_min": 0.0}, {"h_min": math.nan}, {"max_steps": 0}, {"max_steps": -3},
+])
+def test_bad_adaptive_settings_are_parameter_errors(bad: dict[str, float]) -> None:
+    with pytest.raises(rvdyn.ParameterError):
+        simulate(Scene.paper("rated"), 1e-3, "generalized-alpha-adaptive", **bad)
+
+
+def test_a_minimum_step_above_the_run_and_a_step_budget_are_refused_with_advice() -> None:
+    with pytest.raises(rvdyn.ParameterError, match="h_min"):
+        simulate(Scene.paper("rated"), 1e-3, "generalized-alpha-adaptive", h_min=1.0)
+    for integrator in ("generalized-alpha-adaptive", "dopri5"):
+        with pytest.raises(rvdyn.SimulationError, match=r"max_steps = 10 .*raise max_steps"):
+            simulate(Scene.paper("rated"), 0.01, integrator, max_steps=10)
+
+
+def test_options_carry_the_new_settings() -> None:
+    o = rvdyn.Options("generalized-alpha-adaptive", h_min=1e-11, max_steps=1000, step_check="off")
+    d = o.to_dict()
+    assert (d["h_min"], d["max_steps"], d["step_check"]) == (1e-11, 1000, "off")
+    assert rvdyn.Options(**d) == o
+    assert "step_check='off'" in repr(o)
+    assert "generalized-alpha-adaptive" in rvdyn.INTEGRATORS
