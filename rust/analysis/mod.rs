@@ -4,7 +4,7 @@ pub mod efficiency;
 pub mod load_sharing;
 pub mod ltca;
 pub mod modal;
-pub mod pin_load_sharing;
 pub mod orders;
+pub mod pin_load_sharing;
 
 pub use load_sharing::{classical_levers, classical_pin_forces};
