@@ -193,6 +193,16 @@ def test_ltca_kernel_rows_are_finite_metrics() -> None:
     scene0 = SCENE.replace(**{"pin_errors.radius": [float(t[f"pin_errors.radius.{i}"][0]) for i in range(24)]})
     direct = rvdyn.study.LtcaKernel()(scene0)
     assert direct == {k: float(t[k][0]) for k in rvdyn.study.LTCA_METRICS}
+    # ... and the public analysis functions give the same metrics (one solver per sample in
+    # the kernel, a fresh one per call here: equal to the Newton tolerance, 1e-12 relative).
+    te = rvdyn.analysis.transmission_error(scene0, None, 24)
+    static = rvdyn.ltca(scene0, None, te.crank_angle)
+    loop = rvdyn.analysis.torque_twist(scene0, None, 0.0, 41)
+    public = {"te_pp_forward": te.peak_to_peak()["forward"], "te_pp_reverse": te.peak_to_peak()["reverse"],
+              "peak_pin_force": static.peak_pin_force, "loaded_pins_min": float(static.loaded_pins.min()),
+              "torsional_rigidity": loop.rigidity, "lost_motion": loop.lost_motion}
+    for k, v in public.items():
+        assert direct[k] == pytest.approx(v, rel=1e-9), k
 
 
 def test_ltca_kernel_threads_and_serial_give_the_same_table() -> None:

@@ -158,19 +158,25 @@ class LtcaKernel:
         return tuple(LTCA_METRICS)
 
     def __call__(self, scene: Scene) -> dict[str, float]:
-        from ..analysis import ltca, torque_twist, transmission_error
+        # The computations of rvdyn.analysis.transmission_error, ltca and torque_twist, on one
+        # solver (built once per sample; the same metrics to ~1e-12 relative, about 20 % less
+        # work per sample).
+        from .. import _core
+        from ..analysis.ltca import _rated, _scene
 
-        te = transmission_error(scene, self.torque, self.points)
-        pp = te.peak_to_peak()
-        static = ltca(scene, te.torque, te.crank_angle)
-        loop = torque_twist(scene, te.torque, self.crank_angle, self.twist_points)
+        sc = _scene(scene)
+        torque = abs(_rated(sc, self.torque))
+        solver = _core.LtcaSolver(sc._compiled, 1e-12)
+        te = solver.transmission_error(torque, 1e-6 * torque, self.points, 0.0)
+        static = solver.sweep(torque, np.asarray(te["crank_angle"], dtype=float).tolist())
+        loop = solver.twist_loop(torque, float(self.crank_angle), self.twist_points)
         return {
-            "te_pp_forward": pp["forward"],
-            "te_pp_reverse": pp["reverse"],
-            "peak_pin_force": static.peak_pin_force,
-            "loaded_pins_min": float(np.min(static.arrays["loaded_pins"])),
-            "torsional_rigidity": float(loop.rigidity),
-            "lost_motion": float(loop.lost_motion),
+            "te_pp_forward": float(np.ptp(te["forward"])),
+            "te_pp_reverse": float(np.ptp(te["reverse"])),
+            "peak_pin_force": float(np.max(static["pin_force"])) if static["pin_force"].size else 0.0,
+            "loaded_pins_min": float(np.min(static["loaded_pins"])),
+            "torsional_rigidity": float(loop["rigidity"]),
+            "lost_motion": float(loop["lost_motion"]),
         }
 
 
