@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 import os
+from typing import Any, Callable, Iterable
 
 import numpy as np
 import pytest
@@ -85,8 +86,10 @@ def test_bad_study_arguments_are_clear_errors() -> None:
         rvdyn.study(SCENE, "dynamic", TOLS, samples=2, kernel_options=TINY, criteria=[Criterion("te", max=1.0)])
     with pytest.raises(rvdyn.ParameterError, match="map"):
         rvdyn.study(SCENE, linear_metric, TOLS, samples=2, runner=object())
-    with pytest.raises(rvdyn.ParameterError, match="'ltca'.*not available"):
-        rvdyn.study(SCENE, "ltca", TOLS, samples=2)
+    with pytest.raises(rvdyn.ParameterError, match="ltca kernel: points"):
+        rvdyn.study(SCENE, "ltca", TOLS, samples=2, kernel_options={"points": 1})
+    with pytest.raises(rvdyn.ParameterError, match="ltca kernel: torque"):
+        rvdyn.study(SCENE, "ltca", TOLS, samples=2, kernel_options={"torque": math.nan})
     with pytest.raises(rvdyn.ParameterError, match="unknown kernel 'quasi'"):
         rvdyn.study(SCENE, "quasi", TOLS, samples=2)
     with pytest.raises(rvdyn.ParameterError, match="samples"):
@@ -163,6 +166,74 @@ def test_failed_samples_are_rows_with_their_error() -> None:
     assert len(t) == 20 and 0 < bad.sum() < 20
     assert (t["error"][bad].str.contains("SimulationError: d_rrp > 0")).all()
     assert t["y"][bad].isna().all() and (t["error"][~bad] == "").all()
+
+
+# ---------------------------------------------------------------------------------- ltca kernel
+PIN_TOLS = [Tolerance("pin_errors.radius", tol=5e-6)]
+
+
+class SerialRunner:
+    """The plain built-in map: one sample after the other in this thread."""
+
+    def map(self, fn: Callable[[Any], Any], items: Iterable[Any]) -> list[Any]:
+        return list(map(fn, items))
+
+
+def test_ltca_kernel_rows_are_finite_metrics() -> None:
+    t = rvdyn.study(SCENE, "ltca", PIN_TOLS, samples=3, seed=7, runner=1)
+    assert list(t["sample"]) == [0, 1, 2]
+    assert set(rvdyn.study.LTCA_METRICS) <= set(t.columns)
+    assert (t["error"] == "").all()
+    metrics = t[list(rvdyn.study.LTCA_METRICS)].to_numpy()
+    assert np.isfinite(metrics).all()
+    assert (t["te_pp_forward"] > 0).all() and (t["te_pp_reverse"] > 0).all()
+    assert (t["peak_pin_force"] > 0).all() and (t["loaded_pins_min"] >= 1).all()
+    assert (t["torsional_rigidity"] > 0).all() and (t["lost_motion"] >= 0).all()
+    # A row equals the kernel run directly on that sample's scene.
+    scene0 = SCENE.replace(**{"pin_errors.radius": [float(t[f"pin_errors.radius.{i}"][0]) for i in range(24)]})
+    direct = rvdyn.study.LtcaKernel()(scene0)
+    assert direct == {k: float(t[k][0]) for k in rvdyn.study.LTCA_METRICS}
+    # ... and the public analysis functions give the same metrics (one solver per sample in
+    # the kernel, a fresh one per call here: equal to the Newton tolerance, 1e-12 relative).
+    te = rvdyn.analysis.transmission_error(scene0, None, 24)
+    static = rvdyn.ltca(scene0, None, te.crank_angle)
+    loop = rvdyn.analysis.torque_twist(scene0, None, 0.0, 41)
+    public = {"te_pp_forward": te.peak_to_peak()["forward"], "te_pp_reverse": te.peak_to_peak()["reverse"],
+              "peak_pin_force": static.peak_pin_force, "loaded_pins_min": float(static.loaded_pins.min()),
+              "torsional_rigidity": loop.rigidity, "lost_motion": loop.lost_motion}
+    for k, v in public.items():
+        assert direct[k] == pytest.approx(v, rel=1e-9), k
+
+
+def test_ltca_kernel_threads_and_serial_give_the_same_table() -> None:
+    tols = PIN_TOLS + [Tolerance("cycloid.d_rrp", tol=1e-5)]
+    threads = rvdyn.study(SCENE, "ltca", tols, samples=4, seed=11, runner=2)
+    serial = rvdyn.study(SCENE, "ltca", tols, samples=4, seed=11, runner=SerialRunner())
+    assert threads.equals(serial)
+
+
+def test_ltca_kernel_te_grows_with_the_d_rrp_tolerance() -> None:
+    # d_rrp > 0 (a larger pin-radius modification) drops pins out of contact: the TE
+    # peak-to-peak grows with it (docs/model.md, "Quasi-static analysis"); a one-sided band
+    # [0, upper] of 20 um against one of 1 um, same seed.
+    def te(upper: float) -> np.ndarray:
+        tol = Tolerance("cycloid.d_rrp", lower=0.0, upper=upper, dist="uniform")
+        t = rvdyn.study(SCENE, "ltca", [tol], samples=4, seed=3, runner=1)
+        assert (t["error"] == "").all()
+        return t["te_pp_forward"].to_numpy()
+
+    small, large = te(1e-6), te(2e-5)
+    assert large.mean() > 1.05 * small.mean()
+    assert np.ptp(large) > 5.0 * np.ptp(small)
+
+
+def test_ltca_kernel_unsupported_scene_is_an_error_row() -> None:
+    # The physical preset's line-contact pin law is not linearised in the quasi-static
+    # analysis: each sample becomes a row with the SceneError, the study goes on.
+    t = rvdyn.study(rvdyn.Scene.physical("rated"), "ltca", [Tolerance("cycloid.d_rrp", tol=1e-5)], samples=2,
+                    seed=0, runner=1)
+    assert len(t) == 2 and t["error"].str.contains("SceneError").all()
+    assert t["te_pp_forward"].isna().all()
 
 
 def test_numpy_table_without_pandas() -> None:

@@ -7,7 +7,7 @@ Format (SI units; every table but ``tolerances`` optional)::
     changes = { initial = "steady" } # dotted paths -> values, applied to the scene
 
     [kernel]
-    name = "dynamic"                 # or "ltca" (later versions)
+    name = "dynamic"                 # or "ltca" (options torque, points, ...)
     t_end = 0.5                      # other keys are the kernel's options
 
     [sampling]

@@ -34,7 +34,9 @@ pub(crate) fn set_path(
     value: serde_json::Value,
 ) -> Result<()> {
     let keys = path_keys(path)?;
-    let (last, parents) = keys.split_last().expect("non-empty path");
+    let (last, parents) = keys
+        .split_last()
+        .ok_or_else(|| RvdynError::Scene("a scene field path must not be empty".into()))?;
     let missing = || RvdynError::Scene(format!("scene has no field {path:?}"));
     let mut node = tree;
     for key in parents {
