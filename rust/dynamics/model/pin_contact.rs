@@ -180,3 +180,44 @@ impl SeparationBound {
         self.gap > moved
     }
 }
+
+/// One (disc, pin) pair as both models evaluate it: the separation skip (when `separation` is
+/// given), the exact query, the bound update and the penetration check (when `max_penetration`
+/// is given). `Ok(None)` when the pin does not touch.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn touching_pin(
+    disc: &DiscModel,
+    pin: &PinModel,
+    pose: &DiscPose,
+    t: f64,
+    labels: (usize, usize),
+    warm: &Cell<WarmStart>,
+    separation: Option<(&Cell<SeparationBound>, f64)>,
+    max_penetration: Option<f64>,
+) -> Result<Option<PinContact>> {
+    if let Some((bound, reach)) = separation
+        && bound.get().separated(pose.centre, pose.angle, reach)
+    {
+        return Ok(None);
+    }
+    let pc = pin_query(disc, pin, pose, t, labels, warm)?;
+    if let Some((bound, _)) = separation {
+        bound.set(SeparationBound {
+            centre: pose.centre,
+            angle: pose.angle,
+            gap: -pc.penetration,
+        });
+    }
+    if pc.penetration <= 0.0 {
+        return Ok(None);
+    }
+    let pen = pc.penetration;
+    if let Some(bound) = max_penetration
+        && (pen.is_nan() || pen >= bound)
+    {
+        let what = format!("pin {} on disc {}", labels.1 + 1, labels.0);
+        return Err(penetration_error(t, pen, bound, &what));
+    }
+    Ok(Some(pc))
+}

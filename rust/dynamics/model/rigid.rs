@@ -15,7 +15,7 @@
 use crate::contact::law::PinSite;
 pub(crate) use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::pin_contact::{
-    DiscPose, SeparationBound, WarmStart, penetration_error, pin_query,
+    DiscPose, SeparationBound, WarmStart, penetration_error, touching_pin,
 };
 use crate::dynamics::run::sink::ContactSink;
 use crate::dynamics::scene::{Initial, Joints, Scene};
@@ -191,31 +191,16 @@ impl RigidModel {
             let pose = DiscPose::new(o, th);
             for (j, pin) in self.pins.iter().enumerate() {
                 let idx = k * self.pins.len() + j;
-                if self.skip_separated
-                    && self.separation[idx]
-                        .get()
-                        .separated(o, th, self.profile_reach)
-                {
+                let sep = self
+                    .skip_separated
+                    .then(|| (&self.separation[idx], self.profile_reach));
+                let bound = check.then_some(self.max_penetration);
+                let warm = &self.warm_seeds[idx];
+                let Some(pc) = touching_pin(d, pin, &pose, t, (k, j), warm, sep, bound)? else {
                     sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
                     continue;
-                }
-                let pc = pin_query(d, pin, &pose, t, (k, j), &self.warm_seeds[idx])?;
-                if self.skip_separated {
-                    self.separation[idx].set(SeparationBound {
-                        centre: o,
-                        angle: th,
-                        gap: -pc.penetration,
-                    });
-                }
-                if pc.penetration <= 0.0 {
-                    sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
-                    continue;
-                }
+                };
                 let pen = pc.penetration;
-                if check && (pen.is_nan() || pen >= self.max_penetration) {
-                    let what = format!("pin {} on disc {k}", j + 1);
-                    return Err(penetration_error(t, pen, self.max_penetration, &what));
-                }
                 // Levers of the normal about the disc centre (carrier DOF) and about the axis
                 // through O_k (crank DOF).
                 let n = pc.normal;

@@ -3,9 +3,7 @@
 
 use super::{CARRIER, CompliantModel, Flows, SUN, crank_index};
 use crate::contact::law::PinSite;
-use crate::dynamics::model::pin_contact::{
-    DiscPose, SeparationBound, penetration_error, pin_query,
-};
+use crate::dynamics::model::pin_contact::{DiscPose, penetration_error, touching_pin};
 use crate::dynamics::model::vec2::{add, cross, dot, perp, rotate, scaled, sub};
 use crate::dynamics::run::sink::ContactSink;
 use crate::error::{Result, RvdynError};
@@ -169,29 +167,16 @@ impl CompliantModel {
             let pose = DiscPose::new(o, th);
             for (j, pin) in m.pins.iter().enumerate() {
                 let idx = k * m.pins.len() + j;
-                if self.skip_separated
-                    && self.separation[idx].get().separated(o, th, m.profile_reach)
-                {
+                let sep = self
+                    .skip_separated
+                    .then(|| (&self.separation[idx], m.profile_reach));
+                let bound = sink.checks_bounds().then_some(m.max_penetration);
+                let warm = &self.warm_seeds[idx];
+                let Some(pc) = touching_pin(disc, pin, &pose, t, (k, j), warm, sep, bound)? else {
                     sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
                     continue;
-                }
-                let pc = pin_query(disc, pin, &pose, t, (k, j), &self.warm_seeds[idx])?;
-                if self.skip_separated {
-                    self.separation[idx].set(SeparationBound {
-                        centre: o,
-                        angle: th,
-                        gap: -pc.penetration,
-                    });
-                }
-                if pc.penetration <= 0.0 {
-                    sink.pin(k, j, 0.0, 0.0, 0.0, [0.0; 2], [0.0; 2]);
-                    continue;
-                }
+                };
                 let pen = pc.penetration;
-                if sink.checks_bounds() && (pen.is_nan() || pen >= m.max_penetration) {
-                    let what = format!("pin {} on disc {k}", j + 1);
-                    return Err(penetration_error(t, pen, m.max_penetration, &what));
-                }
                 let n = pc.normal;
                 let lever = pc.lever();
                 let pen_rate = dot(n, ov) + vt * lever;
