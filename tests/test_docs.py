@@ -2,9 +2,8 @@
 commands it names exist, and the claims of docs/model.md that no other test checks are checked.
 
 Every ```python block of docs/guide.md runs, in order, in one namespace (later blocks use the
-names earlier ones define), in a temporary folder. A block preceded by a comment
-``<!-- requires: NAME -->`` needs an API that is being added: it is skipped, with the reason,
-until NAME is in :data:`AVAILABLE` (the lead enables it after merging the change).
+names earlier ones define), in a temporary folder; none may be marked as waiting for an API
+(``<!-- requires: NAME -->``).
 """
 
 from __future__ import annotations
@@ -22,17 +21,6 @@ ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 GUIDE = DOCS / "guide.md"
 
-
-def _has_options() -> bool:
-    return hasattr(rvdyn, "Options")
-
-
-#: Features a guide block may require, and whether this version has them. "sweep-ok" (sweep
-#: returns result objects with ``ok``/``error``) is enabled by hand once it lands.
-AVAILABLE: dict[str, bool] = {
-    "Options": _has_options(),
-    "sweep-ok": False,
-}
 
 FENCE = re.compile(r"(?:<!--\s*requires:\s*(?P<req>[\w-]+)\s*-->\s*\n)?```(?P<lang>\w*)\n(?P<body>.*?)\n```",
                    re.DOTALL)
@@ -63,15 +51,12 @@ def session(tmp_path_factory: pytest.TempPathFactory) -> dict:
 
 def test_the_guide_has_code() -> None:
     assert len(GUIDE_BLOCKS) >= 15
-    assert all(req is None or req in AVAILABLE for _, req, _ in GUIDE_BLOCKS), \
-        "a block requires a feature that tests/test_docs.py does not know"
+    assert all(req is None for _, req, _ in GUIDE_BLOCKS), "every guide block must run"
 
 
 @pytest.mark.parametrize("line, req, code", GUIDE_BLOCKS, ids=[f"guide.md:{b[0]}" for b in GUIDE_BLOCKS])
 def test_guide_block_runs(line: int, req: str | None, code: str, session: dict,
                           monkeypatch: pytest.MonkeyPatch) -> None:
-    if req is not None and not AVAILABLE[req]:
-        pytest.skip(f"docs/guide.md line {line} needs {req!r}, which this version does not have yet")
     monkeypatch.chdir(session["_cwd"])
     import matplotlib.pyplot as plt
 
@@ -150,8 +135,10 @@ def test_model_has_the_sections_others_link_to() -> None:
 def test_docs_cite_nothing_outside_the_repository() -> None:
     for path in DOC_FILES:
         text = path.read_text(encoding="utf-8")
-        for bad in ("design.md", "notes/physics", "paper.txt", "/work/"):
+        for bad in ("design.md", "notes/physics", "paper.txt"):
             assert bad not in text, f"{path.name} cites {bad}"
+        machine_path = re.search(r"(?<![\w.])/(?:work|home|root|tmp)/", text)
+        assert machine_path is None, f"{path.name} names a machine path"
 
 
 # ---- claims of docs/model.md checked here ------------------------------------------------------
