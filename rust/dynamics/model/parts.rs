@@ -5,7 +5,7 @@ use crate::contact::friction::{CoulombFriction, ToothPath};
 use crate::contact::law::{MeshLaw, PinLaw};
 use crate::dynamics::model::Layout;
 use crate::dynamics::model::drive::DriveProfile;
-use crate::dynamics::scene::{Initial, Load, Scene};
+use crate::dynamics::scene::{GearError, Initial, Load, ProfileError, Scene, Shaft};
 use crate::error::{Result, RvdynError};
 use crate::geometry::CycloidGeometry;
 use crate::geometry::mass::{DiscHoles, MassProperties, disc_mass_properties, solid_cylinder};
@@ -21,6 +21,8 @@ pub(crate) struct DiscModel {
     /// Body depth of the disc for the line contact law [m]: pin circle radius minus pin
     /// radius (about the distance from the disc centre to a contact).
     pub(crate) body_depth: f64,
+    /// Profile error (normal offset of the ground profile), `None` when there is none.
+    pub(crate) profile_error: Option<ProfileError>,
 }
 
 /// One fixed pin.
@@ -60,6 +62,7 @@ pub(crate) struct ModelInertias {
     pub(crate) disc: MassProperties,
     pub(crate) carrier: MassProperties,
     pub(crate) load_inertia: f64,
+    pub(crate) motor_inertia: f64,
 }
 
 /// The bodies, contacts, laws, inertias, drive and load of a scene.
@@ -97,6 +100,12 @@ pub struct Parts {
     pub(crate) max_penetration: f64,
     /// Largest distance of a profile point from its disc centre [m].
     pub(crate) profile_reach: f64,
+    /// Output shaft between the carrier and the load inertia (`None`: rigid).
+    pub(crate) output_shaft: Option<Shaft>,
+    /// Drive shaft between the motor and the sun (`None`: rigid).
+    pub(crate) input_shaft: Option<Shaft>,
+    /// Runout and pitch errors of the first-stage gears (`None`: perfect gears).
+    pub(crate) mesh_errors: Option<MeshErrors>,
 }
 
 impl Parts {
@@ -112,6 +121,7 @@ impl Parts {
                 phase: d.phase,
                 angle_offset: -d.phase / zc,
                 body_depth: cyc.pin_circle_radius - cyc.pin_radius,
+                profile_error: d.profile_error.clone().filter(|p| !p.is_empty()),
             });
         }
         let pins = (0..zp)
@@ -203,8 +213,81 @@ impl Parts {
                     p.pin_circle_radius + p.d_rp + p.eccentricity - p.pin_radius - p.d_rrp
                 })
                 .fold(0.0, f64::max)
-                * 1.000_001,
+                * 1.000_001
+                // A profile error moves the profile outwards by at most its bound.
+                + scene
+                    .discs
+                    .iter()
+                    .filter_map(|d| d.profile_error.as_ref())
+                    .map(|p| {
+                        p.harmonics.iter().map(|h| h[0].abs()).sum::<f64>()
+                            + p.table.iter().map(|q| q[1].abs()).fold(0.0, f64::max)
+                    })
+                    .fold(0.0, f64::max),
+            output_shaft: scene.shafts.output,
+            input_shaft: scene.shafts.input,
+            mesh_errors: match &scene.stage1 {
+                Some(s) if scene.gear_errors.any() => Some(MeshErrors::new(scene, s)),
+                _ => None,
+            },
         })
+    }
+
+    /// Load torque acting on the carrier at `t` [N m]: the scene's load, or 0 when an output
+    /// shaft carries it to the load inertia.
+    #[inline]
+    pub(crate) fn carrier_load(&self, t: f64) -> f64 {
+        if self.output_shaft.is_some() {
+            0.0
+        } else {
+            self.load.torque(t)
+        }
+    }
+
+    /// Drive torque acting on the reducer's input at `t` [N m] (torque drive without a drive
+    /// shaft), else `None`.
+    #[inline]
+    pub(crate) fn input_drive_torque(&self, t: f64) -> Option<f64> {
+        if self.input_shaft.is_some() {
+            None
+        } else {
+            self.drive.torque(t)
+        }
+    }
+
+    /// Torques of the output and drive shafts at `t` from (angle [rad], speed [rad/s]) of
+    /// the carrier, the reducer input (sun), the load and the motor (docs/model.md#machine-shafts).
+    pub(crate) fn shaft_loads(
+        &self,
+        t: f64,
+        carrier: [f64; 2],
+        input: [f64; 2],
+        load: [f64; 2],
+        motor: [f64; 2],
+    ) -> ShaftLoads {
+        let mut out = ShaftLoads::default();
+        if let Some(sh) = &self.output_shaft {
+            let (tw, rate) = (carrier[0] - load[0], carrier[1] - load[1]);
+            let tq = sh.stiffness * tw + sh.damping * rate;
+            out.carrier -= tq;
+            out.load += tq - self.load.torque(t);
+            out.output_torque = tq;
+            out.potential += 0.5 * sh.stiffness * tw * tw;
+            out.dissipation += sh.damping * rate * rate;
+        }
+        if let Some(sh) = &self.input_shaft {
+            let (tw, rate) = (motor[0] - input[0], motor[1] - input[1]);
+            let tq = sh.stiffness * tw + sh.damping * rate;
+            out.input += tq;
+            out.motor -= tq;
+            if let Some(d) = self.drive.torque(t) {
+                out.motor += d;
+            }
+            out.input_torque = tq;
+            out.potential += 0.5 * sh.stiffness * tw * tw;
+            out.dissipation += sh.damping * rate * rate;
+        }
+        out
     }
 
     /// Sizes of the bodies and contacts (the shapes of recorded arrays).
@@ -264,6 +347,7 @@ fn default_inertias(
         disc: disc_mp,
         carrier,
         load_inertia: i.load_inertia,
+        motor_inertia: i.motor_inertia,
     })
 }
 
@@ -271,5 +355,131 @@ fn add(a: MassProperties, b: MassProperties) -> MassProperties {
     MassProperties {
         mass: a.mass + b.mass,
         inertia: a.inertia + b.inertia,
+    }
+}
+
+/// Generalised forces and energy of the machine shafts (see [`Parts::shaft_loads`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct ShaftLoads {
+    /// Torque on the carrier [N m].
+    pub(crate) carrier: f64,
+    /// Torque on the reducer input (sun) [N m].
+    pub(crate) input: f64,
+    /// Torque on the load inertia (shaft minus load torque) [N m].
+    pub(crate) load: f64,
+    /// Torque on the motor (drive minus shaft torque) [N m].
+    pub(crate) motor: f64,
+    /// Torque in the output shaft, `k_o (th_c - th_L) + c_o (w_c - w_L)` [N m].
+    pub(crate) output_torque: f64,
+    /// Torque in the drive shaft, `k_i (th_m - th_s) + c_i (w_m - w_s)` [N m].
+    pub(crate) input_torque: f64,
+    /// Elastic energy of the shafts [J].
+    pub(crate) potential: f64,
+    /// Power dissipated by the shaft damping [W].
+    pub(crate) dissipation: f64,
+}
+
+/// Runout and pitch errors of the first-stage gears as an extra approach of each mesh flank
+/// (docs/model.md#manufacturing-errors-of-profile-and-gears).
+#[derive(Debug, Clone)]
+pub(crate) struct MeshErrors {
+    sun: GearModelError,
+    planets: Vec<GearModelError>,
+    /// Angle of each planet on the carrier [rad].
+    gamma: Vec<f64>,
+    pressure_angle: f64,
+    cos_pa: f64,
+}
+
+/// One gear's errors, with its pitch table at the tooth angles.
+#[derive(Debug, Clone, Default)]
+struct GearModelError {
+    runout: f64,
+    runout_phase: f64,
+    pitch_amplitude: f64,
+    pitch_phase: f64,
+    table: Vec<[f64; 2]>,
+}
+
+impl GearModelError {
+    fn new(g: &GearError) -> Self {
+        let z = g.pitch_deviation.len() as f64;
+        Self {
+            runout: g.runout,
+            runout_phase: g.runout_phase,
+            pitch_amplitude: g.pitch_amplitude,
+            pitch_phase: g.pitch_phase,
+            table: g
+                .pitch_deviation
+                .iter()
+                .enumerate()
+                .map(|(k, &f)| [std::f64::consts::TAU * k as f64 / z, f])
+                .collect(),
+        }
+    }
+
+    /// Cumulative pitch deviation [m] and its slope [m/rad] at body angle `psi`.
+    fn pitch(&self, psi: f64) -> (f64, f64) {
+        let (s, c) = (psi + self.pitch_phase).sin_cos();
+        let (t, ts) = crate::geometry::cycloid::periodic_table(&self.table, psi);
+        (self.pitch_amplitude * s + t, self.pitch_amplitude * c + ts)
+    }
+}
+
+/// Extra approach of one mesh flank [m] and its derivatives by the carrier, sun and crank
+/// angles [m/rad].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct MeshOffset {
+    pub(crate) value: f64,
+    pub(crate) carrier: f64,
+    pub(crate) sun: f64,
+    pub(crate) crank: f64,
+}
+
+impl MeshOffset {
+    /// Rate of the offset for the speeds of carrier, sun and crank [m/s].
+    #[inline]
+    pub(crate) fn rate(&self, vc: f64, vs: f64, va: f64) -> f64 {
+        self.carrier * vc + self.sun * vs + self.crank * va
+    }
+}
+
+impl MeshErrors {
+    fn new(scene: &Scene, s: &crate::geometry::involute::InvoluteStage) -> Self {
+        let g = &scene.gear_errors;
+        let n = s.planets as usize;
+        Self {
+            sun: GearModelError::new(&g.sun),
+            planets: (0..n)
+                .map(|i| g.planets.get(i).map(GearModelError::new).unwrap_or_default())
+                .collect(),
+            gamma: s.planet_angles(),
+            pressure_angle: s.pressure_angle,
+            cos_pa: s.pressure_angle.cos(),
+        }
+    }
+
+    /// Extra approach of flank `sign` (+1 drive, -1 coast) of mesh `i` at carrier angle
+    /// `thc`, sun angle `ths` and absolute crank angle `alpha` [rad]:
+    /// `E = sign cos(pa) (F_s(th_c + g_i - th_s) + F_p(th_c + g_i + pi - alpha))
+    /// + e_s cos(th_s + p_s - psi) - e_p cos(alpha + p_p - psi)`, with
+    /// `psi = th_c + g_i + sign (pi/2 - pa)` the direction of the flank's line of action.
+    pub(crate) fn offset(&self, i: usize, sign: f64, thc: f64, ths: f64, alpha: f64) -> MeshOffset {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let g = self.gamma[i];
+        let p = &self.planets[i];
+        let (fs, fs1) = self.sun.pitch(thc + g - ths);
+        let (fp, fp1) = p.pitch(thc + g + PI - alpha);
+        let psi = thc + g + sign * (FRAC_PI_2 - self.pressure_angle);
+        let (ss, cs) = (ths + self.sun.runout_phase - psi).sin_cos();
+        let (sp, cp) = (alpha + p.runout_phase - psi).sin_cos();
+        let (es, ep) = (self.sun.runout, p.runout);
+        let k = sign * self.cos_pa;
+        MeshOffset {
+            value: k * (fs + fp) + es * cs - ep * cp,
+            carrier: k * (fs1 + fp1) + es * ss - ep * sp,
+            sun: -k * fs1 - es * ss,
+            crank: -k * fp1 + ep * sp,
+        }
     }
 }

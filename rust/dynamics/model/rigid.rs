@@ -14,6 +14,7 @@
 
 use crate::contact::law::PinSite;
 pub(crate) use crate::dynamics::model::parts::Parts;
+use crate::dynamics::model::parts::MeshOffset;
 use crate::dynamics::model::pin_contact::{
     DiscPose, SeparationBound, WarmStart, penetration_error, touching_pin,
 };
@@ -28,11 +29,18 @@ pub const CARRIER: usize = 0;
 pub const CRANK: usize = 1;
 /// Index of the sun angle.
 pub const SUN: usize = 2;
+/// Index of the load angle (a coordinate only with an output shaft).
+pub const LOAD: usize = 3;
+/// Index of the motor angle (a coordinate only with a drive shaft).
+pub const MOTOR: usize = 4;
+/// Number of full coordinates `[th_c, alpha, th_s, th_L, th_m]`.
+pub const FULL: usize = 5;
 
 /// Generalised forces and power flows from one evaluation.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Forces {
-    /// Generalised forces on `[th_c, alpha, th_s]` [N m].
+    /// Generalised forces on `[th_c, alpha, th_s]` [N m] (the shafts' on the load and motor
+    /// are added by the adapter).
     pub(crate) q: [f64; 3],
     /// Power dissipated by contact damping [W].
     pub(crate) dissipation: f64,
@@ -48,8 +56,8 @@ pub(crate) struct Forces {
 pub struct RigidModel {
     /// Geometry, laws, inertias, drive and load (shared with the compliant model).
     pub(crate) parts: Parts,
-    /// Diagonal generalised mass of `[th_c, alpha, th_s]`.
-    pub(crate) mass: [f64; 3],
+    /// Diagonal generalised mass of `[th_c, alpha, th_s, th_L, th_m]`.
+    pub(crate) mass: [f64; FULL],
     /// Free coordinates (indices into the full vector).
     pub(crate) free: Vec<usize>,
     /// The prescribed coordinate, if the drive is a speed.
@@ -57,7 +65,7 @@ pub struct RigidModel {
     /// The coordinate the drive acts on (sun, or crank without a first stage).
     pub(crate) input: usize,
     /// Lever length per full coordinate [m per rad], turning angle errors into displacements.
-    pub(crate) length_scale: [f64; 3],
+    pub(crate) length_scale: [f64; FULL],
     /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start).
     pub(crate) warm_seeds: Vec<Cell<WarmStart>>,
     /// Skip the exact query of a pin that provably cannot touch (see [`SeparationBound`]).
@@ -90,23 +98,54 @@ impl RigidModel {
         let n_cr = f64::from(scene.cranks);
         let e = cyc.eccentricity;
         let nd = parts.discs.len() as f64;
+        // The load and motor inertias join the carrier and the sun unless a shaft separates
+        // them (docs/model.md#machine-shafts).
+        let (on_carrier, on_sun) = (
+            if parts.output_shaft.is_some() {
+                0.0
+            } else {
+                inertias.load_inertia
+            },
+            if parts.input_shaft.is_some() {
+                0.0
+            } else {
+                inertias.motor_inertia
+            },
+        );
         let mass = [
             inertias.carrier.inertia
-                + inertias.load_inertia
+                + on_carrier
                 + n_cr * inertias.crank.mass * crank_radius * crank_radius
                 + nd * inertias.disc.inertia,
             n_cr * inertias.crank.inertia + nd * inertias.disc.mass * e * e,
-            inertias.sun.inertia,
+            inertias.sun.inertia + on_sun,
+            inertias.load_inertia,
+            inertias.motor_inertia,
         ];
-        let input = if mesh.is_some() { SUN } else { CRANK };
-        let (free, prescribed) = match (parts.drive.is_speed(), mesh.is_some()) {
+        let mut input = if mesh.is_some() { SUN } else { CRANK };
+        let (mut free, mut prescribed) = match (parts.drive.is_speed(), mesh.is_some()) {
             (true, true) => (vec![CARRIER, CRANK], Some(SUN)),
             (false, true) => (vec![CARRIER, CRANK, SUN], None),
             (true, false) => (vec![CARRIER], Some(CRANK)),
             (false, false) => (vec![CARRIER, CRANK], None),
         };
+        if parts.output_shaft.is_some() {
+            free.push(LOAD);
+        }
+        if parts.input_shaft.is_some() {
+            // The drive acts on the motor; the sun becomes free.
+            if let Some(p) = prescribed {
+                free.push(p);
+                prescribed = Some(MOTOR);
+            } else {
+                free.push(MOTOR);
+            }
+            input = MOTOR;
+        }
         let rp = cyc.pin_circle_radius;
-        let length_scale = [rp, e, mesh.map_or(0.0, |m| m.sun_base_radius)];
+        let rs = mesh.map_or(0.0, |m| m.sun_base_radius);
+        let length_scale = [rp, e, rs, rp, rs];
+        let skip = parts.discs.iter().all(|d| d.profile_error.is_none());
         Ok(Self {
             parts,
             mass,
@@ -115,24 +154,24 @@ impl RigidModel {
             input,
             length_scale,
             warm_seeds: vec![Cell::new(WarmStart::default()); scene.discs.len() * zp],
-            skip_separated: true,
+            // The separation bound assumes a rigid profile; a profile error's first-order offset
+            // is not one: query every pin.
+            skip_separated: skip,
             separation: vec![Cell::new(SeparationBound::default()); scene.discs.len() * zp],
         })
     }
 
-    /// Initial full state `(x, v)` at t = 0: kinematic pose, at rest or at kinematic speed.
-    pub(crate) fn initial_state(&self) -> ([f64; 3], [f64; 3]) {
-        let x = [0.0, 0.0, 0.0];
-        let mut v = [0.0; 3];
+    /// Initial full state `(x, v)` at t = 0: kinematic pose, at rest or at kinematic speed
+    /// (shafts untwisted).
+    pub(crate) fn initial_state(&self) -> ([f64; FULL], [f64; FULL]) {
+        let x = [0.0; FULL];
+        let mut v = [0.0; FULL];
         if self.initial == Initial::Steady {
             let w_in = self.drive.full_speed();
             let zc = self.zc();
             let carrier = w_in / self.ratio;
-            v = [
-                carrier,
-                -zc * carrier,
-                if self.mesh.is_some() { w_in } else { 0.0 },
-            ];
+            let sun = if self.mesh.is_some() { w_in } else { 0.0 };
+            v = [carrier, -zc * carrier, sun, carrier, sun];
         }
         if let Some(p) = self.prescribed {
             let (ang, spd, _) = self.drive.motion(0.0);
@@ -147,7 +186,7 @@ impl RigidModel {
     /// Overwrite the prescribed coordinate of a full state with the drive at time `t`;
     /// returns its acceleration.
     #[inline]
-    pub(crate) fn apply_drive(&self, t: f64, x: &mut [f64; 3], v: &mut [f64; 3]) -> f64 {
+    pub(crate) fn apply_drive(&self, t: f64, x: &mut [f64; FULL], v: &mut [f64; FULL]) -> f64 {
         match self.prescribed {
             Some(p) => {
                 let (ang, spd, acc) = self.drive.motion(t);
@@ -206,7 +245,13 @@ impl RigidModel {
                 let n = pc.normal;
                 let lever_c = pc.lever();
                 let lever_a = o[0] * n[1] - o[1] * n[0];
-                let pen_rate = lever_c * vc + lever_a * va;
+                let mut pen_rate = lever_c * vc + lever_a * va;
+                // A profile error's share of the penetration moves with the foot:
+                // d/dth_c = g_theta, d/dalpha = g_O . (z x O).
+                let err_lever = pc.error_gradient.map(|(go, gt)| (gt, go[1] * o[0] - go[0] * o[1]));
+                if let Some((ec, ea)) = err_lever {
+                    pen_rate += ec * vc + ea * va;
+                }
                 let site = PinSite {
                     geometry: &d.geometry,
                     phi: pc.phi,
@@ -217,6 +262,10 @@ impl RigidModel {
                 let f = lf.force;
                 out.q[CARRIER] -= f * lever_c;
                 out.q[CRANK] -= f * lever_a;
+                if let Some((ec, ea)) = err_lever {
+                    out.q[CARRIER] -= f * ec;
+                    out.q[CRANK] -= f * ea;
+                }
                 // Sliding friction: the disc's material point at the contact moves at
                 // O' + th' z x arm (O' = alpha' z x O); the force ft t (t = z x n) on the disc
                 // has the virtual work ft (arm . n) on th_c and ft (O . n) on alpha.
@@ -265,6 +314,30 @@ impl RigidModel {
                 (0.0, 0.0, 0.0)
             };
             for i in 0..m.count {
+                let mut f_report = 0.0;
+                let mut delta_report = delta;
+                // Without gear errors one flank at most, shared by all planets; with errors
+                // each flank of each planet has its own extra approach (runout, pitch).
+                let mut flanks = [(pen, pen_rate, sign, MeshOffset::default()); 2];
+                let nf = match &self.mesh_errors {
+                    None => 1,
+                    Some(me) => {
+                        for (slot, sg) in flanks.iter_mut().zip([1.0, -1.0]) {
+                            let off = me.offset(i, sg, x[CARRIER], x[SUN], x[CRANK]);
+                            *slot = (
+                                sg * delta + off.value - half,
+                                sg * rate + off.rate(vc, v[SUN], va),
+                                sg,
+                                off,
+                            );
+                            if sg > 0.0 {
+                                delta_report = delta + off.value;
+                            }
+                        }
+                        2
+                    }
+                };
+                for &(pen, pen_rate, sign, off) in &flanks[..nf] {
                 let mut f = 0.0;
                 if pen > 0.0 {
                     if check && (pen.is_nan() || pen >= self.max_penetration) {
@@ -283,6 +356,12 @@ impl RigidModel {
                     out.q[CARRIER] += f * (m.sun_base_radius + m.planet_base_radius);
                     out.q[CRANK] -= f * m.planet_base_radius;
                     out.q[SUN] -= f * m.sun_base_radius;
+                    // Gear errors: -F grad(E) (zero without them).
+                    if self.mesh_errors.is_some() {
+                        out.q[CARRIER] -= lf.force * off.carrier;
+                        out.q[SUN] -= lf.force * off.sun;
+                        out.q[CRANK] -= lf.force * off.crank;
+                    }
                     // A stiffness that varies with the mesh position s stores
                     // V = k(s) pen^2 / 2; its s-derivative is a generalised force too
                     // (ds/dth_s = r_bs, ds/dth_c = -r_bs), which keeps the energy balance
@@ -304,11 +383,13 @@ impl RigidModel {
                         out.friction[1] += p;
                     }
                 }
-                sink.mesh(i, f, delta);
+                f_report += f;
+                }
+                sink.mesh(i, f_report, delta_report);
             }
         }
-        out.q[CARRIER] -= self.load.torque(t);
-        if let Some(tq) = self.drive.torque(t) {
+        out.q[CARRIER] -= self.carrier_load(t);
+        if let Some(tq) = self.input_drive_torque(t) {
             out.q[self.input] += tq;
         }
         if !out.q.iter().all(|v| v.is_finite()) {
@@ -321,9 +402,14 @@ impl RigidModel {
     }
 
     /// Kinetic energy of the free bodies [J] (the prescribed input is a driver, not counted).
-    pub(crate) fn kinetic_energy(&self, v: &[f64; 3]) -> f64 {
-        (0..3)
-            .filter(|i| Some(*i) != self.prescribed && (*i != SUN || self.mesh.is_some()))
+    pub(crate) fn kinetic_energy(&self, v: &[f64; FULL]) -> f64 {
+        (0..FULL)
+            .filter(|i| {
+                Some(*i) != self.prescribed
+                    && (*i != SUN || self.mesh.is_some())
+                    && (*i != LOAD || self.output_shaft.is_some())
+                    && (*i != MOTOR || self.input_shaft.is_some())
+            })
             .map(|i| 0.5 * self.mass[i] * v[i] * v[i])
             .sum()
     }
@@ -360,7 +446,9 @@ mod tests {
         for step in 0..300 {
             ga.step(&sys, &mut st, 1e-4).unwrap();
             for wobble in [0.0, 3e-6, -2e-5] {
-                let (mut x, xv, _) = sys.full(st.t, &st.q, &st.v);
+                let (x5, xv5, _) = sys.full(st.t, &st.q, &st.v);
+                let mut x = [x5[0], x5[1], x5[2]];
+                let xv = [xv5[0], xv5[1], xv5[2]];
                 x[CARRIER] += wobble * ((step % 7) as f64 - 3.0);
                 let a = skipping.forces(st.t, &x, &xv, &mut NoSink).unwrap();
                 let b = fresh.forces(st.t, &x, &xv, &mut NoSink).unwrap();

@@ -1,6 +1,7 @@
 //! The rigid-joint model seen by the integrators: free coordinates only.
 
-use crate::dynamics::model::rigid::{CARRIER, CRANK, Forces, RigidModel, SUN};
+use crate::dynamics::model::parts::ShaftLoads;
+use crate::dynamics::model::rigid::{CARRIER, CRANK, FULL, Forces, LOAD, MOTOR, RigidModel, SUN};
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
 use crate::dynamics::run::sink::{ContactSink, DynSink, NoSink};
 use crate::error::Result;
@@ -21,16 +22,54 @@ impl<'a> RigidSystem<'a> {
 
     /// Full coordinates from free ones at time `t` (prescribed ones from the drive); returns
     /// the prescribed acceleration.
+    /// Without a shaft, the load (motor) angle is the carrier (input) angle.
     #[inline]
-    pub(crate) fn full(&self, t: f64, q: &[f64], v: &[f64]) -> ([f64; 3], [f64; 3], f64) {
-        let mut x = [0.0; 3];
-        let mut xv = [0.0; 3];
-        for (k, &i) in self.model.free.iter().enumerate() {
+    pub(crate) fn full(&self, t: f64, q: &[f64], v: &[f64]) -> ([f64; FULL], [f64; FULL], f64) {
+        let m = self.model;
+        let mut x = [0.0; FULL];
+        let mut xv = [0.0; FULL];
+        for (k, &i) in m.free.iter().enumerate() {
             x[i] = q[k];
             xv[i] = v[k];
         }
-        let acc = self.model.apply_drive(t, &mut x, &mut xv);
+        let acc = m.apply_drive(t, &mut x, &mut xv);
+        if m.output_shaft.is_none() {
+            (x[LOAD], xv[LOAD]) = (x[CARRIER], xv[CARRIER]);
+        }
+        if m.input_shaft.is_none() {
+            let i = if m.mesh.is_some() { SUN } else { CRANK };
+            (x[MOTOR], xv[MOTOR]) = (x[i], xv[i]);
+        }
         (x, xv, acc)
+    }
+
+    /// Generalised forces on all five coordinates: the reducer's plus the shafts'.
+    #[inline]
+    fn all_forces<S: crate::dynamics::run::sink::ContactSink>(
+        &self,
+        t: f64,
+        x: &[f64; FULL],
+        xv: &[f64; FULL],
+        sink: &mut S,
+    ) -> Result<(Forces, [f64; FULL], ShaftLoads)> {
+        let m = self.model;
+        let f = m.forces(t, &[x[0], x[1], x[2]], &[xv[0], xv[1], xv[2]], sink)?;
+        let mut q = [f.q[0], f.q[1], f.q[2], 0.0, 0.0];
+        let mut sh = ShaftLoads::default();
+        if m.output_shaft.is_some() || m.input_shaft.is_some() {
+            sh = m.shaft_loads(
+                t,
+                [x[CARRIER], xv[CARRIER]],
+                [x[SUN], xv[SUN]],
+                [x[LOAD], xv[LOAD]],
+                [x[MOTOR], xv[MOTOR]],
+            );
+            q[CARRIER] += sh.carrier;
+            q[SUN] += sh.input;
+            q[LOAD] += sh.load;
+            q[MOTOR] += sh.motor;
+        }
+        Ok((f, q, sh))
     }
 }
 
@@ -49,17 +88,17 @@ impl MechanicalSystem for RigidSystem<'_> {
     ) -> Result<()> {
         let m = self.model;
         let (x, xv, _) = self.full(t, q, v);
-        let f = m.forces(t, &x, &xv, &mut NoSink)?;
+        let (f, qa, sh) = self.all_forces(t, &x, &xv, &mut NoSink)?;
         for (k, &i) in m.free.iter().enumerate() {
-            a[k] = f.q[i] / m.mass[i];
+            a[k] = qa[i] / m.mass[i];
         }
         power[0] = match (m.prescribed, m.drive.torque(t)) {
-            (Some(p), _) => -f.q[p] * xv[p],
+            (Some(p), _) => -qa[p] * xv[p],
             (None, Some(tq)) => tq * xv[m.input],
             (None, None) => 0.0,
         };
-        power[1] = m.load.torque(t) * xv[CARRIER];
-        power[2] = f.dissipation;
+        power[1] = m.load.torque(t) * xv[LOAD];
+        power[2] = f.dissipation + sh.dissipation;
         Ok(())
     }
 
@@ -79,9 +118,9 @@ impl ReducerModel for RigidSystem<'_> {
 
     fn generalized_force(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
         let (x, xv, _) = self.full(t, q, v);
-        let f = self.model.forces(t, &x, &xv, &mut NoSink)?;
+        let (_, qa, _) = self.all_forces(t, &x, &xv, &mut NoSink)?;
         for (k, &i) in self.model.free.iter().enumerate() {
-            out[k] = f.q[i];
+            out[k] = qa[i];
         }
         Ok(())
     }
@@ -108,18 +147,27 @@ impl ReducerModel for RigidSystem<'_> {
     ) -> Result<Observation> {
         let m = self.model;
         let (x, xv, acc) = self.full(t, q, v);
-        let f = if sink.wants_forces() {
-            m.forces(t, &x, &xv, &mut DynSink(sink))?
+        let (f, qa, sh) = if sink.wants_forces() {
+            self.all_forces(t, &x, &xv, &mut DynSink(sink))?
         } else {
-            Forces::default()
+            let sh = m.shaft_loads(
+                t,
+                [x[CARRIER], xv[CARRIER]],
+                [x[SUN], xv[SUN]],
+                [x[LOAD], xv[LOAD]],
+                [x[MOTOR], xv[MOTOR]],
+            );
+            (Forces::default(), [0.0; FULL], sh)
         };
         let input_torque = match (m.prescribed, m.drive.torque(t)) {
-            (Some(p), _) => m.mass[p] * acc - f.q[p],
+            (Some(p), _) => m.mass[p] * acc - qa[p],
             (None, Some(tq)) => tq,
             (None, None) => 0.0,
         };
         let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) =
-            (0..m.discs.len()).map(|k| m.disc_pose(k, &x)).unzip();
+            (0..m.discs.len())
+                .map(|k| m.disc_pose(k, &[x[0], x[1], x[2]]))
+                .unzip();
         Ok(Observation {
             sun_angle: x[SUN],
             sun_speed: xv[SUN],
@@ -131,8 +179,22 @@ impl ReducerModel for RigidSystem<'_> {
             disc_angle: angles,
             input_torque,
             kinetic_energy: m.kinetic_energy(&xv),
-            potential_energy: f.potential,
+            potential_energy: f.potential + sh.potential,
             friction_power: f.friction,
+            load_angle: x[LOAD],
+            load_speed: xv[LOAD],
+            motor_angle: x[MOTOR],
+            motor_speed: xv[MOTOR],
+            output_shaft_torque: if m.output_shaft.is_some() {
+                sh.output_torque
+            } else {
+                m.load.torque(t)
+            },
+            input_shaft_torque: if m.input_shaft.is_some() {
+                sh.input_torque
+            } else {
+                input_torque
+            },
         })
     }
 }
