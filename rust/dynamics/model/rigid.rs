@@ -13,8 +13,8 @@
 //! `M_ii a_i - Q_i` on them is the input torque.
 
 use crate::contact::law::PinSite;
-pub(crate) use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::parts::MeshOffset;
+pub(crate) use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::pin_contact::{
     DiscPose, SeparationBound, WarmStart, penetration_error, touching_pin,
 };
@@ -248,7 +248,9 @@ impl RigidModel {
                 let mut pen_rate = lever_c * vc + lever_a * va;
                 // A profile error's share of the penetration moves with the foot:
                 // d/dth_c = g_theta, d/dalpha = g_O . (z x O).
-                let err_lever = pc.error_gradient.map(|(go, gt)| (gt, go[1] * o[0] - go[0] * o[1]));
+                let err_lever = pc
+                    .error_gradient
+                    .map(|(go, gt)| (gt, go[1] * o[0] - go[0] * o[1]));
                 if let Some((ec, ea)) = err_lever {
                     pen_rate += ec * vc + ea * va;
                 }
@@ -338,52 +340,52 @@ impl RigidModel {
                     }
                 };
                 for &(pen, pen_rate, sign, off) in &flanks[..nf] {
-                let mut f = 0.0;
-                if pen > 0.0 {
-                    if check && (pen.is_nan() || pen >= self.max_penetration) {
-                        return Err(penetration_error(
-                            t,
-                            pen,
-                            self.max_penetration,
-                            "a sun/planet mesh",
-                        ));
+                    let mut f = 0.0;
+                    if pen > 0.0 {
+                        if check && (pen.is_nan() || pen >= self.max_penetration) {
+                            return Err(penetration_error(
+                                t,
+                                pen,
+                                self.max_penetration,
+                                "a sun/planet mesh",
+                            ));
+                        }
+                        // The coast flank (sign -1) runs through its tooth pairs in the mirrored
+                        // order: its mesh position is -s.
+                        let s_flank = sign * (s0 + m.phases[i] * m.base_pitch);
+                        let (lf, dk) = m.law.evaluate(pen, pen_rate, s_flank, want_energy);
+                        f = sign * lf.force;
+                        out.q[CARRIER] += f * (m.sun_base_radius + m.planet_base_radius);
+                        out.q[CRANK] -= f * m.planet_base_radius;
+                        out.q[SUN] -= f * m.sun_base_radius;
+                        // Gear errors: -F grad(E) (zero without them).
+                        if self.mesh_errors.is_some() {
+                            out.q[CARRIER] -= lf.force * off.carrier;
+                            out.q[SUN] -= lf.force * off.sun;
+                            out.q[CRANK] -= lf.force * off.crank;
+                        }
+                        // A stiffness that varies with the mesh position s stores
+                        // V = k(s) pen^2 / 2; its s-derivative is a generalised force too
+                        // (ds/dth_s = r_bs, ds/dth_c = -r_bs), which keeps the energy balance
+                        // (Oh, Grosh & Barber 2005).
+                        let dv_ds = 0.5 * dk * pen * pen * sign;
+                        out.q[SUN] -= dv_ds * m.sun_base_radius;
+                        out.q[CARRIER] += dv_ds * m.sun_base_radius;
+                        out.dissipation += (lf.force - lf.elastic) * pen_rate;
+                        out.potential += lf.energy;
+                        // Tooth friction (mirrored on the coast flank like the mesh position).
+                        if let Some(fr) = &self.mesh_friction {
+                            let w1 = sign * (v[SUN] - vc);
+                            let w2 = sign * (va - vc);
+                            let (t1, t2, p) = m.path.torques(fr, lf.force, s_flank, w1, w2);
+                            out.q[SUN] += sign * t1;
+                            out.q[CRANK] += sign * t2;
+                            out.q[CARRIER] -= sign * (t1 + t2);
+                            out.dissipation += p;
+                            out.friction[1] += p;
+                        }
                     }
-                    // The coast flank (sign -1) runs through its tooth pairs in the mirrored
-                    // order: its mesh position is -s.
-                    let s_flank = sign * (s0 + m.phases[i] * m.base_pitch);
-                    let (lf, dk) = m.law.evaluate(pen, pen_rate, s_flank, want_energy);
-                    f = sign * lf.force;
-                    out.q[CARRIER] += f * (m.sun_base_radius + m.planet_base_radius);
-                    out.q[CRANK] -= f * m.planet_base_radius;
-                    out.q[SUN] -= f * m.sun_base_radius;
-                    // Gear errors: -F grad(E) (zero without them).
-                    if self.mesh_errors.is_some() {
-                        out.q[CARRIER] -= lf.force * off.carrier;
-                        out.q[SUN] -= lf.force * off.sun;
-                        out.q[CRANK] -= lf.force * off.crank;
-                    }
-                    // A stiffness that varies with the mesh position s stores
-                    // V = k(s) pen^2 / 2; its s-derivative is a generalised force too
-                    // (ds/dth_s = r_bs, ds/dth_c = -r_bs), which keeps the energy balance
-                    // (Oh, Grosh & Barber 2005).
-                    let dv_ds = 0.5 * dk * pen * pen * sign;
-                    out.q[SUN] -= dv_ds * m.sun_base_radius;
-                    out.q[CARRIER] += dv_ds * m.sun_base_radius;
-                    out.dissipation += (lf.force - lf.elastic) * pen_rate;
-                    out.potential += lf.energy;
-                    // Tooth friction (mirrored on the coast flank like the mesh position).
-                    if let Some(fr) = &self.mesh_friction {
-                        let w1 = sign * (v[SUN] - vc);
-                        let w2 = sign * (va - vc);
-                        let (t1, t2, p) = m.path.torques(fr, lf.force, s_flank, w1, w2);
-                        out.q[SUN] += sign * t1;
-                        out.q[CRANK] += sign * t2;
-                        out.q[CARRIER] -= sign * (t1 + t2);
-                        out.dissipation += p;
-                        out.friction[1] += p;
-                    }
-                }
-                f_report += f;
+                    f_report += f;
                 }
                 sink.mesh(i, f_report, delta_report);
             }

@@ -45,7 +45,7 @@ impl<'a> RigidSystem<'a> {
 
     /// Generalised forces on all five coordinates: the reducer's plus the shafts'.
     #[inline]
-    fn all_forces<S: crate::dynamics::run::sink::ContactSink>(
+    pub(crate) fn all_forces<S: crate::dynamics::run::sink::ContactSink>(
         &self,
         t: f64,
         x: &[f64; FULL],
@@ -164,10 +164,9 @@ impl ReducerModel for RigidSystem<'_> {
             (None, Some(tq)) => tq,
             (None, None) => 0.0,
         };
-        let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) =
-            (0..m.discs.len())
-                .map(|k| m.disc_pose(k, &[x[0], x[1], x[2]]))
-                .unzip();
+        let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = (0..m.discs.len())
+            .map(|k| m.disc_pose(k, &[x[0], x[1], x[2]]))
+            .unzip();
         Ok(Observation {
             sun_angle: x[SUN],
             sun_speed: xv[SUN],

@@ -965,7 +965,9 @@ pub static FIELDS: &[Field] = &[
         "",
         "object",
         "-",
-        Some("{\"runout\": 0.0, \"runout_phase\": 0.0, \"pitch_amplitude\": 0.0, \"pitch_phase\": 0.0, \"pitch_deviation\": []}"),
+        Some(
+            "{\"runout\": 0.0, \"runout_phase\": 0.0, \"pitch_amplitude\": 0.0, \"pitch_phase\": 0.0, \"pitch_deviation\": []}",
+        ),
         "",
         "errors of the sun",
     ),

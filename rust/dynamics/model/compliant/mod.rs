@@ -86,7 +86,7 @@ pub(crate) struct Flows {
     /// Power dissipated by contact and bearing damping and by friction [W].
     dissipation: f64,
     /// Elastic energy of the contacts and bearings [J] (contacts only when asked for).
-    potential: f64,
+    pub(crate) potential: f64,
     /// Friction power per family [W]: pins, teeth, bearings (part of `dissipation`).
     friction: [f64; 3],
 }
@@ -447,9 +447,11 @@ impl CompliantModel {
         v: &[f64],
     ) -> (crate::dynamics::model::parts::ShaftLoads, usize, usize) {
         let li = self.load_index.unwrap_or(CARRIER);
-        let mi = self
-            .motor_index
-            .unwrap_or(if self.parts.mesh.is_some() { SUN } else { crank_index(0) + 2 });
+        let mi = self.motor_index.unwrap_or(if self.parts.mesh.is_some() {
+            SUN
+        } else {
+            crank_index(0) + 2
+        });
         let sh = if self.load_index.is_some() || self.motor_index.is_some() {
             self.parts.shaft_loads(
                 t,
