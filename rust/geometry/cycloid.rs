@@ -135,8 +135,10 @@ impl ProfileError {
             + self.table.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
         if size >= limit {
             return bad(format!(
-                "offset bound sum |a| + max |table| = {size:e} m must be below {limit:e} m (a \
-                 tenth of the pin radius)"
+                "offset bound sum |a| + max |table| = {} m must be below {} m (a tenth of the \
+                 pin radius)",
+                num(size),
+                num(limit)
             ));
         }
         Ok(())

@@ -17,7 +17,7 @@ pub use presets::{
 
 use crate::contact::ImpactLaw;
 use crate::contact::law::{ContactDamping, DampingSpec, IsoMesh, MeshLaw, PinLaw, scene_material};
-use crate::error::{Result, RvdynError};
+use crate::error::{Result, RvdynError, num};
 use crate::geometry::cycloid::CycloidParams;
 use crate::geometry::involute::InvoluteStage;
 use crate::geometry::mass::MassProperties;
@@ -117,14 +117,16 @@ impl GearError {
         }
         if !(self.runout.is_finite() && self.runout >= 0.0 && self.runout < limit) {
             return bad(format!(
-                "runout must be in [0, {limit:e}) m (a tenth of the module), got {}",
+                "runout must be in [0, {}) m (a tenth of the module), got {}",
+                num(limit),
                 self.runout
             ));
         }
         if !(self.pitch_amplitude.is_finite() && self.pitch_amplitude.abs() < limit) {
             return bad(format!(
-                "pitch_amplitude must be finite and smaller than {limit:e} m (a tenth of the \
+                "pitch_amplitude must be finite and smaller than {} m (a tenth of the \
                  module) in magnitude, got {}",
+                num(limit),
                 self.pitch_amplitude
             ));
         }
@@ -140,8 +142,9 @@ impl GearError {
             .find(|v| !(v.is_finite() && v.abs() < limit))
         {
             return bad(format!(
-                "pitch_deviation values must be finite and smaller than {limit:e} m (a tenth of \
-                 the module) in magnitude, got {v}"
+                "pitch_deviation values must be finite and smaller than {} m (a tenth of \
+                 the module) in magnitude, got {v}",
+                num(limit)
             ));
         }
         Ok(())
