@@ -49,6 +49,9 @@ pub(crate) struct Forces {
     /// Friction power [W] (>= 0; part of `dissipation`) per family: pin/disc (or pin/housing
     /// for rolling pins), sun/planet teeth, bearings.
     pub(crate) friction: [f64; 3],
+    /// Net load of the pins on each disc (at most 2): force [N] on the centre (fixed frame) and
+    /// moment [N m] about it, friction and location terms included (for the joint reactions).
+    pub(crate) disc_load: [[f64; 3]; 2],
 }
 
 /// The rigid-joint reducer model: the shared [`Parts`] plus its coordinates.
@@ -264,9 +267,18 @@ impl RigidModel {
                 let f = lf.force;
                 out.q[CARRIER] -= f * lever_c;
                 out.q[CRANK] -= f * lever_a;
+                let dl = &mut out.disc_load[k];
+                dl[0] -= f * n[0];
+                dl[1] -= f * n[1];
+                dl[2] -= f * lever_c;
                 if let Some((ec, ea)) = err_lever {
                     out.q[CARRIER] -= f * ec;
                     out.q[CRANK] -= f * ea;
+                    let (go, gt) = pc.error_gradient.unwrap_or_default();
+                    let dl = &mut out.disc_load[k];
+                    dl[0] -= f * go[0];
+                    dl[1] -= f * go[1];
+                    dl[2] -= f * gt;
                 }
                 // Sliding friction: the disc's material point at the contact moves at
                 // O' + th' z x arm (O' = alpha' z x O); the force ft t (t = z x n) on the disc
@@ -278,6 +290,10 @@ impl RigidModel {
                     let ft = fr.force(vs, f);
                     out.q[CARRIER] += ft * (arm[0] * n[0] + arm[1] * n[1]);
                     out.q[CRANK] += ft * (o[0] * n[0] + o[1] * n[1]);
+                    let dl = &mut out.disc_load[k];
+                    dl[0] -= ft * n[1];
+                    dl[1] += ft * n[0];
+                    dl[2] += ft * (arm[0] * n[0] + arm[1] * n[1]);
                     let p = -ft * vs;
                     out.dissipation += p;
                     out.friction[0] += p;
@@ -291,6 +307,10 @@ impl RigidModel {
                     let (fo, m) = ls.forces();
                     out.q[CARRIER] += m;
                     out.q[CRANK] += fo[1] * o[0] - fo[0] * o[1];
+                    let dl = &mut out.disc_load[k];
+                    dl[0] += fo[0];
+                    dl[1] += fo[1];
+                    dl[2] += m;
                 }
                 out.dissipation += (f - lf.elastic) * pen_rate;
                 out.potential += lf.energy;
@@ -401,6 +421,44 @@ impl RigidModel {
             )));
         }
         Ok(out)
+    }
+
+    /// Reactions of the ideal eccentric bearings on the discs [N], at `i * discs + k` (crank
+    /// `i`, disc `k`; fixed frame), from each disc's balance with the pins at the state
+    /// `(x, v)` with accelerations `a` (docs/model.md#bearing-reactions-of-ideal-joints): the net
+    /// reaction `R = m_d O'' - F_pins` and moment `M = J_d theta'' - M_pins` split over the
+    /// cranks as equal isotropic bearings share them, `R_i = R / n + M (z x h_i) / sum |h|^2`
+    /// (`h_i` the hole centres from the disc centre; the split of a redundant support is not
+    /// given by the rigid constraints alone).
+    pub(crate) fn eccentric_reactions(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        a: &[f64],
+        f: &Forces,
+    ) -> Vec<[f64; 2]> {
+        let n = self.cranks;
+        let nd = self.discs.len();
+        let md = self.inertias.disc;
+        let e = self.eccentricity;
+        let mut out = vec![[0.0; 2]; n * nd];
+        let h2 = n as f64 * self.crank_radius * self.crank_radius;
+        for (k, d) in self.discs.iter().enumerate() {
+            let (sb, cb) = (x[CRANK] + d.phase).sin_cos();
+            let (w, dw) = (v[CRANK], a[CRANK]);
+            let acc = [e * (-sb * dw - cb * w * w), e * (cb * dw - sb * w * w)];
+            let dl = f.disc_load[k];
+            let r = [md.mass * acc[0] - dl[0], md.mass * acc[1] - dl[1]];
+            let mr = md.inertia * a[CARRIER] - dl[2];
+            for i in 0..n {
+                let g = std::f64::consts::TAU * i as f64 / n as f64 + x[CARRIER];
+                let (sg, cg) = g.sin_cos();
+                // z x h_i / sum |h|^2, h_i = r_cr (cos g, sin g).
+                let t = [-sg * self.crank_radius / h2, cg * self.crank_radius / h2];
+                out[i * nd + k] = [r[0] / n as f64 + mr * t[0], r[1] / n as f64 + mr * t[1]];
+            }
+        }
+        out
     }
 
     /// Kinetic energy of the free bodies [J] (the prescribed input is a driver, not counted).

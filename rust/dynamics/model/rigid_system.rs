@@ -164,6 +164,20 @@ impl ReducerModel for RigidSystem<'_> {
             (None, Some(tq)) => tq,
             (None, None) => 0.0,
         };
+        if sink.wants_forces() {
+            // Accelerations of the full coordinates: Q / M of the free ones, the drive's of the
+            // prescribed one.
+            let mut xa = [0.0; FULL];
+            for &i in &m.free {
+                xa[i] = qa[i] / m.mass[i];
+            }
+            if let Some(p) = m.prescribed {
+                xa[p] = acc;
+            }
+            for (i, r) in m.eccentric_reactions(&x, &xv, &xa, &f).iter().enumerate() {
+                sink.bearing(1, i, *r);
+            }
+        }
         let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = (0..m.discs.len())
             .map(|k| m.disc_pose(k, &[x[0], x[1], x[2]]))
             .unzip();

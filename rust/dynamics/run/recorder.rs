@@ -391,7 +391,8 @@ pub static CHANNELS: &[ChannelSpec] = &[
         Some(Bearings),
         &[Dim::Cranks, Dim::Discs, Dim::Xy],
         "N",
-        "force of the eccentric bearing of crank i on disc k, fixed frame (0 with ideal joints)",
+        "force of the eccentric bearing of crank i on disc k, fixed frame (ideal joints: the \
+         reactions from each disc's balance, split as equal bearings share them)",
     ),
 ];
 
