@@ -126,3 +126,15 @@ def test_without_shafts_the_new_channels_are_the_rigid_connection() -> None:
 def test_bad_shafts_are_scene_errors_naming_the_field(changes: dict[str, object], match: str) -> None:
     with pytest.raises(SceneError, match=match):
         RATED.replace(**changes)
+
+
+@pytest.mark.parametrize("joints", ["rigid", "compliant"])
+def test_modal_analysis_of_a_scene_with_shafts_is_a_scene_error(joints: str) -> None:
+    # The modal analysis models the reducer alone so far: a scene with shafts is refused with a
+    # SceneError naming the fields (not a crash).
+    from rvdyn.analysis import modes
+
+    for shaft in ({"inertias.load_inertia": 5.0, "shafts.output": {"stiffness": 1e6}},
+                  {"inertias.motor_inertia": 0.01, "shafts.input": {"stiffness": 1e4}}):
+        with pytest.raises(SceneError, match=r"shafts\.output / shafts\.input"):
+            modes.modes(_with(RATED.replace(**shaft), joints))

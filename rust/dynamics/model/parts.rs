@@ -715,7 +715,7 @@ mod tests {
         let s = errors_scene(true);
         let m = RigidModel::new(&s).unwrap();
         let sys = RigidSystem::new(&m);
-        assert_eq!(m.free, vec![CARRIER, CRANK, SUN, LOAD, MOTOR]);
+        assert_eq!(sys.coords, vec![CARRIER, CRANK, SUN, LOAD, MOTOR]);
         let (mut q, _) = sys.initial_state();
         let v = vec![0.0; q.len()];
         q[0] += 1e-5; // carrier: pins loaded
@@ -735,7 +735,7 @@ mod tests {
         assert!(probe.pins >= 4, "{}", probe.pins);
         assert!(probe.mesh.iter().all(|m| m.0 > 0.0));
         let fmax = qf.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-        for (k, &i) in m.free.iter().enumerate() {
+        for (k, &i) in sys.coords.iter().enumerate() {
             let h = 1e-9 / m.length_scale[i];
             let (mut qp, mut qm) = (q.clone(), q.clone());
             qp[k] += h;
@@ -757,7 +757,8 @@ mod tests {
         let m = CompliantModel::new(&s).unwrap();
         let (mut x, _) = m.full_initial_state();
         let (li, mi) = (m.load_index.unwrap(), m.motor_index.unwrap());
-        assert!(m.free.contains(&li) && m.free.contains(&mi));
+        assert!(m.coords.contains(&li) && m.coords.contains(&mi));
+        assert!(!m.free.contains(&li) && !m.free.contains(&mi));
         let v = vec![0.0; x.len()];
         x[0] += 1e-5;
         x[1] += 1e-3;
@@ -774,9 +775,9 @@ mod tests {
         m.forces(0.0, &x, &v, &mut qf, &mut probe).unwrap();
         assert!(probe.pins >= 4 && probe.mesh.iter().all(|m| m.0 > 0.0));
         let fmax = qf.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-        for &i in &m.free {
+        for &i in &m.coords {
             use crate::solve::MechanicalSystem;
-            let h = 1e-9 / m.length_scale()[m.free.iter().position(|&f| f == i).unwrap()];
+            let h = 1e-9 / m.length_scale()[m.coords.iter().position(|&f| f == i).unwrap()];
             let (mut xp, mut xm) = (x.clone(), x.clone());
             xp[i] += h;
             xm[i] -= h;

@@ -63,6 +63,9 @@ pub struct RigidModel {
     pub(crate) mass: [f64; FULL],
     /// Free coordinates (indices into the full vector).
     pub(crate) free: Vec<usize>,
+    /// Free shaft coordinates (`LOAD`, `MOTOR`; empty without shafts). The adapter's
+    /// coordinates are `free` then these.
+    pub(crate) shaft_free: Vec<usize>,
     /// The prescribed coordinate, if the drive is a speed.
     pub(crate) prescribed: Option<usize>,
     /// The coordinate the drive acts on (sun, or crank without a first stage).
@@ -132,8 +135,9 @@ impl RigidModel {
             (true, false) => (vec![CARRIER], Some(CRANK)),
             (false, false) => (vec![CARRIER, CRANK], None),
         };
+        let mut shaft_free = Vec::new();
         if parts.output_shaft.is_some() {
-            free.push(LOAD);
+            shaft_free.push(LOAD);
         }
         if parts.input_shaft.is_some() {
             // The drive acts on the motor; the sun becomes free.
@@ -141,7 +145,7 @@ impl RigidModel {
                 free.push(p);
                 prescribed = Some(MOTOR);
             } else {
-                free.push(MOTOR);
+                shaft_free.push(MOTOR);
             }
             input = MOTOR;
         }
@@ -153,6 +157,7 @@ impl RigidModel {
             parts,
             mass,
             free,
+            shaft_free,
             prescribed,
             input,
             length_scale,

@@ -10,14 +10,26 @@ use crate::solve::MechanicalSystem;
 /// Adapter from [`RigidModel`] (full coordinates) to a [`MechanicalSystem`] in the free ones.
 pub struct RigidSystem<'a> {
     pub(crate) model: &'a RigidModel,
+    /// The free coordinates: the reducer's (`model.free`), then the shafts'.
+    pub(crate) coords: Vec<usize>,
     scale: Vec<f64>,
 }
 
 impl<'a> RigidSystem<'a> {
     /// The adapter of a built model.
     pub fn new(model: &'a RigidModel) -> Self {
-        let scale = model.free.iter().map(|&i| model.length_scale[i]).collect();
-        Self { model, scale }
+        let coords: Vec<usize> = model
+            .free
+            .iter()
+            .chain(&model.shaft_free)
+            .copied()
+            .collect();
+        let scale = coords.iter().map(|&i| model.length_scale[i]).collect();
+        Self {
+            model,
+            coords,
+            scale,
+        }
     }
 
     /// Full coordinates from free ones at time `t` (prescribed ones from the drive); returns
@@ -28,7 +40,7 @@ impl<'a> RigidSystem<'a> {
         let m = self.model;
         let mut x = [0.0; FULL];
         let mut xv = [0.0; FULL];
-        for (k, &i) in m.free.iter().enumerate() {
+        for (k, &i) in self.coords.iter().enumerate() {
             x[i] = q[k];
             xv[i] = v[k];
         }
@@ -75,7 +87,7 @@ impl<'a> RigidSystem<'a> {
 
 impl MechanicalSystem for RigidSystem<'_> {
     fn dof(&self) -> usize {
-        self.model.free.len()
+        self.coords.len()
     }
 
     fn eval(
@@ -89,7 +101,7 @@ impl MechanicalSystem for RigidSystem<'_> {
         let m = self.model;
         let (x, xv, _) = self.full(t, q, v);
         let (f, qa, sh) = self.all_forces(t, &x, &xv, &mut NoSink)?;
-        for (k, &i) in m.free.iter().enumerate() {
+        for (k, &i) in self.coords.iter().enumerate() {
             a[k] = qa[i] / m.mass[i];
         }
         power[0] = match (m.prescribed, m.drive.torque(t)) {
@@ -109,17 +121,24 @@ impl MechanicalSystem for RigidSystem<'_> {
 
 impl ReducerModel for RigidSystem<'_> {
     fn free_mass(&self) -> Vec<f64> {
-        self.model
-            .free
-            .iter()
-            .map(|&i| self.model.mass[i])
-            .collect()
+        self.coords.iter().map(|&i| self.model.mass[i]).collect()
     }
 
     fn generalized_force(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
+        let n = self.coords.len();
+        if q.len() != n || v.len() != n || out.len() != n {
+            // An analysis built on the reducer's coordinates alone meets a scene with shafts.
+            return Err(crate::error::RvdynError::Scene(format!(
+                "the rigid model of this scene has {n} free coordinates ({} with machine shafts: \
+                 shafts.output / shafts.input), got {}: the analysis does not model the shafts \
+                 yet; set them to null for it",
+                self.model.shaft_free.len(),
+                q.len()
+            )));
+        }
         let (x, xv, _) = self.full(t, q, v);
         let (_, qa, _) = self.all_forces(t, &x, &xv, &mut NoSink)?;
-        for (k, &i) in self.model.free.iter().enumerate() {
+        for (k, &i) in self.coords.iter().enumerate() {
             out[k] = qa[i];
         }
         Ok(())
@@ -131,7 +150,7 @@ impl ReducerModel for RigidSystem<'_> {
 
     fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
         let (x, v) = self.model.initial_state();
-        let free = &self.model.free;
+        let free = &self.coords;
         (
             free.iter().map(|&i| x[i]).collect(),
             free.iter().map(|&i| v[i]).collect(),
@@ -168,7 +187,7 @@ impl ReducerModel for RigidSystem<'_> {
             // Accelerations of the full coordinates: Q / M of the free ones, the drive's of the
             // prescribed one.
             let mut xa = [0.0; FULL];
-            for &i in &m.free {
+            for &i in &self.coords {
                 xa[i] = qa[i] / m.mass[i];
             }
             if let Some(p) = m.prescribed {

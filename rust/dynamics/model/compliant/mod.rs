@@ -111,8 +111,11 @@ pub struct CompliantModel {
     pressure: [f64; 2],
     /// Diagonal mass of every full coordinate [kg or kg m^2].
     pub(crate) mass: Vec<f64>,
-    /// Free coordinates (indices into the full vector).
+    /// Free coordinates of the reducer (indices into the full vector; what the quasi-static
+    /// and modal analyses see).
     pub(crate) free: Vec<usize>,
+    /// All free coordinates: `free`, then the machine shafts' (load, motor).
+    pub(crate) coords: Vec<usize>,
     /// Prescribed coordinates (the sun, or every crank rotation without a first stage).
     pub(crate) prescribed: Vec<usize>,
     /// Coordinates the input torque acts on (shared equally).
@@ -277,11 +280,16 @@ impl CompliantModel {
         let crank_centres: Vec<usize> = (0..n)
             .flat_map(|i| [crank_index(i), crank_index(i) + 1])
             .collect();
-        let free: Vec<usize> = (0..n_full)
+        let coords: Vec<usize> = (0..n_full)
             .filter(|i| !prescribed.contains(i) && (*i != SUN || has_mesh))
             .filter(|i| !(rigid_cranks && crank_centres.contains(i)))
             .collect();
-        let scale = free.iter().map(|&i| lever[i]).collect();
+        let free: Vec<usize> = coords
+            .iter()
+            .copied()
+            .filter(|i| Some(*i) != load_index && Some(*i) != motor_index)
+            .collect();
+        let scale = coords.iter().map(|&i| lever[i]).collect();
         let base_skip = base.discs.iter().all(|d| d.profile_error.is_none());
         Ok(Self {
             parts: base,
@@ -293,6 +301,7 @@ impl CompliantModel {
             pressure,
             mass,
             free,
+            coords,
             prescribed,
             input,
             scale,
@@ -404,7 +413,7 @@ impl CompliantModel {
         let n_full = self.full_len();
         let mut x = vec![0.0; n_full];
         let mut xv = vec![0.0; n_full];
-        for (k, &i) in self.free.iter().enumerate() {
+        for (k, &i) in self.coords.iter().enumerate() {
             x[i] = q[k];
             xv[i] = v[k];
         }
@@ -468,7 +477,7 @@ impl CompliantModel {
 
     /// Kinetic energy of the free bodies [J] (a prescribed input is a driver, not counted).
     fn kinetic_energy(&self, v: &[f64]) -> f64 {
-        self.free
+        self.coords
             .iter()
             .map(|&i| 0.5 * self.mass[i] * v[i] * v[i])
             .sum()
@@ -483,7 +492,7 @@ fn crank_index(i: usize) -> usize {
 
 impl MechanicalSystem for CompliantModel {
     fn dof(&self) -> usize {
-        self.free.len()
+        self.coords.len()
     }
 
     fn eval(
@@ -497,7 +506,7 @@ impl MechanicalSystem for CompliantModel {
         let (x, xv, _) = self.full(t, q, v);
         let mut qf = vec![0.0; x.len()];
         let flows = self.forces(t, &x, &xv, &mut qf, &mut NoSink)?;
-        for (k, &i) in self.free.iter().enumerate() {
+        for (k, &i) in self.coords.iter().enumerate() {
             a[k] = qf[i] / self.mass[i];
         }
         let m = &self.parts;
@@ -520,14 +529,25 @@ impl MechanicalSystem for CompliantModel {
 
 impl ReducerModel for CompliantModel {
     fn free_mass(&self) -> Vec<f64> {
-        self.free.iter().map(|&i| self.mass[i]).collect()
+        self.coords.iter().map(|&i| self.mass[i]).collect()
     }
 
     fn generalized_force(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
+        let n = self.coords.len();
+        if q.len() != n || v.len() != n || out.len() != n {
+            // An analysis built on the reducer's coordinates alone meets a scene with shafts.
+            return Err(RvdynError::Scene(format!(
+                "the compliant model of this scene has {n} free coordinates ({} with machine \
+                 shafts: shafts.output / shafts.input), got {}: the analysis does not model the \
+                 shafts yet; set them to null for it",
+                n - self.free.len(),
+                q.len()
+            )));
+        }
         let (x, xv, _) = self.full(t, q, v);
         let mut qf = vec![0.0; x.len()];
         self.forces(t, &x, &xv, &mut qf, &mut NoSink)?;
-        for (k, &i) in self.free.iter().enumerate() {
+        for (k, &i) in self.coords.iter().enumerate() {
             out[k] = qf[i];
         }
         Ok(())
@@ -540,8 +560,8 @@ impl ReducerModel for CompliantModel {
     fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
         let (x, v) = self.full_initial_state();
         (
-            self.free.iter().map(|&i| x[i]).collect(),
-            self.free.iter().map(|&i| v[i]).collect(),
+            self.coords.iter().map(|&i| x[i]).collect(),
+            self.coords.iter().map(|&i| v[i]).collect(),
         )
     }
 
