@@ -99,6 +99,32 @@ impl MechanicalSystem for RigidSystem<'_> {
         power: &mut [f64; 3],
     ) -> Result<()> {
         let m = self.model;
+        if m.shaft_free.is_empty() && m.input_shaft.is_none() {
+            // No shafts: the reducer's three coordinates only (the hot path).
+            let mut x = [0.0; 3];
+            let mut xv = [0.0; 3];
+            for (k, &i) in m.free.iter().enumerate() {
+                x[i] = q[k];
+                xv[i] = v[k];
+            }
+            if let Some(p) = m.prescribed {
+                let (ang, spd, _) = m.drive.motion(t);
+                x[p] = ang;
+                xv[p] = spd;
+            }
+            let f = m.forces(t, &x, &xv, &mut NoSink)?;
+            for (k, &i) in m.free.iter().enumerate() {
+                a[k] = f.q[i] / m.mass[i];
+            }
+            power[0] = match (m.prescribed, m.drive.torque(t)) {
+                (Some(p), _) => -f.q[p] * xv[p],
+                (None, Some(tq)) => tq * xv[m.input],
+                (None, None) => 0.0,
+            };
+            power[1] = m.load.torque(t) * xv[CARRIER];
+            power[2] = f.dissipation;
+            return Ok(());
+        }
         let (x, xv, _) = self.full(t, q, v);
         let (f, qa, sh) = self.all_forces(t, &x, &xv, &mut NoSink)?;
         for (k, &i) in self.coords.iter().enumerate() {
