@@ -99,7 +99,7 @@ impl MechanicalSystem for RigidSystem<'_> {
         power: &mut [f64; 3],
     ) -> Result<()> {
         let m = self.model;
-        if m.shaft_free.is_empty() && m.input_shaft.is_none() {
+        if m.output_shaft.is_none() && m.input_shaft.is_none() {
             // No shafts: the reducer's three coordinates only (the hot path).
             let mut x = [0.0; 3];
             let mut xv = [0.0; 3];
@@ -193,7 +193,19 @@ impl ReducerModel for RigidSystem<'_> {
         let m = self.model;
         let (x, xv, acc) = self.full(t, q, v);
         let (f, qa, sh) = if sink.wants_forces() {
-            self.all_forces(t, &x, &xv, &mut DynSink(sink))?
+            if m.output_shaft.is_none() && m.input_shaft.is_none() {
+                // No shafts: the reducer's forces alone, called directly (as in `eval`).
+                let f = m.forces(
+                    t,
+                    &[x[0], x[1], x[2]],
+                    &[xv[0], xv[1], xv[2]],
+                    &mut DynSink(sink),
+                )?;
+                let qa = [f.q[0], f.q[1], f.q[2], 0.0, 0.0];
+                (f, qa, ShaftLoads::default())
+            } else {
+                self.all_forces(t, &x, &xv, &mut DynSink(sink))?
+            }
         } else {
             let sh = m.shaft_loads(
                 t,
