@@ -272,6 +272,7 @@ pub struct FootJet {
 /// The [`FootJet`] of the pin at `pin_centre` [m] against `geometry` placed at `disc_centre`
 /// [m] with `(cos, sin)` of its angle `disc_cos_sin`, at the foot `phi` [rad] (from the gap
 /// query). `None` where `G_phi <= 0` (no unique foot).
+#[allow(clippy::needless_range_loop)]
 pub fn foot_jet(
     geometry: &CycloidGeometry,
     pin_centre: [f64; 2],
@@ -415,6 +416,7 @@ pub fn line_jet(
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
     use crate::geometry::cycloid::CycloidParams;
