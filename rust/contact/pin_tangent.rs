@@ -47,6 +47,8 @@ pub struct GapJet {
     pub phi: f64,
     /// `(cos phi, sin phi)` of the foot (a warm start for the next query).
     pub cos_sin: [f64; 2],
+    /// `(cos, sin)` of [`GapJet::phi`] (the foot after its last Newton correction).
+    pub phi_cos_sin: [f64; 2],
     /// Signed radius of curvature of the profile at the contact [m] (positive convex).
     pub curvature_radius: f64,
 }
@@ -195,6 +197,11 @@ pub(crate) fn gap_jet_cs(
         arm,
         phi: foot.phi + dphi,
         cos_sin: foot.cos_sin,
+        phi_cos_sin: {
+            let (sd, cd) = crate::geometry::gap::small_sin_cos(dphi);
+            let [c0, s0] = foot.cos_sin;
+            [c0 * cd - s0 * sd, s0 * cd + c0 * sd]
+        },
         curvature_radius: 1.0 / kappa - r_gen,
     })
 }
@@ -203,12 +210,31 @@ pub(crate) fn gap_jet_cs(
 /// (`R = rp + d_rp`, unrotated disc frame) and its derivatives of order 0 to 4 at `phi` [m]:
 /// `C^(n) = R i^n e^(i phi) - e (i zp)^n e^(i zp phi)` in complex notation.
 pub fn centre_curve_derivatives(geometry: &CycloidGeometry, phi: f64) -> [[f64; 2]; 5] {
+    let (s1, c1) = phi.sin_cos();
+    centre_curve_derivatives_cs(geometry, [c1, s1])
+}
+
+/// As [`centre_curve_derivatives`] from `(cos phi, sin phi)` (`cos zp phi`, `sin zp phi` as
+/// the zp-th complex power, relative error ~zp eps).
+pub fn centre_curve_derivatives_cs(geometry: &CycloidGeometry, cs: [f64; 2]) -> [[f64; 2]; 5] {
     let p = geometry.params();
     let r = p.pin_circle_radius + p.d_rp;
     let e = p.eccentricity;
     let z = f64::from(p.pins);
-    let (s1, c1) = phi.sin_cos();
-    let (sz, cz) = (z * phi).sin_cos();
+    let [c1, s1] = cs;
+    let (cz, sz) = {
+        let (mut rc, mut rs) = (1.0, 0.0);
+        let (mut bc, mut bs) = (c1, s1);
+        let mut n = p.pins;
+        while n > 0 {
+            if n & 1 == 1 {
+                (rc, rs) = (rc * bc - rs * bs, rc * bs + rs * bc);
+            }
+            (bc, bs) = (bc * bc - bs * bs, 2.0 * bc * bs);
+            n >>= 1;
+        }
+        (rc, rs)
+    };
     // i^n (c, s): quarter turns.
     let turn = |n: usize, c: f64, s: f64| match n % 4 {
         0 => [c, s],
@@ -233,7 +259,12 @@ pub fn centre_curve_derivatives(geometry: &CycloidGeometry, phi: f64) -> [[f64; 
 /// (`X' = C' x C'''`, `X'' = C'' x C''' + C' x C''''`, `s' = 2 C'.C''`,
 /// `s'' = 2 (|C''|^2 + C'.C''')`).
 pub fn centre_curvature_derivatives(geometry: &CycloidGeometry, phi: f64) -> [f64; 3] {
-    let [_, c1, c2, c3, c4] = centre_curve_derivatives(geometry, phi);
+    curvature_derivatives_of(&centre_curve_derivatives(geometry, phi))
+}
+
+/// [`centre_curvature_derivatives`] from the curve derivatives `d` (orders 0-4).
+pub fn curvature_derivatives_of(d: &[[f64; 2]; 5]) -> [f64; 3] {
+    let [_, c1, c2, c3, c4] = *d;
     let cross = |a: [f64; 2], b: [f64; 2]| a[0] * b[1] - a[1] * b[0];
     let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
     let x = cross(c1, c2);
@@ -242,7 +273,7 @@ pub fn centre_curvature_derivatives(geometry: &CycloidGeometry, phi: f64) -> [f6
     let s = dot(c1, c1);
     let s1 = 2.0 * dot(c1, c2);
     let s2 = 2.0 * (dot(c2, c2) + dot(c1, c3));
-    let m32 = s.powf(-1.5);
+    let m32 = 1.0 / (s * s.sqrt());
     let m52 = m32 / s;
     let m72 = m52 / s;
     [
@@ -272,13 +303,25 @@ pub struct FootJet {
 /// The [`FootJet`] of the pin at `pin_centre` [m] against `geometry` placed at `disc_centre`
 /// [m] with `(cos, sin)` of its angle `disc_cos_sin`, at the foot `phi` [rad] (from the gap
 /// query). `None` where `G_phi <= 0` (no unique foot).
-#[allow(clippy::needless_range_loop)]
 pub fn foot_jet(
     geometry: &CycloidGeometry,
     pin_centre: [f64; 2],
     disc_centre: [f64; 2],
     disc_cos_sin: [f64; 2],
     phi: f64,
+) -> Option<FootJet> {
+    let d = centre_curve_derivatives(geometry, phi);
+    foot_jet_with(geometry, pin_centre, disc_centre, disc_cos_sin, &d)
+}
+
+/// As [`foot_jet`] with the curve derivatives at the foot given (orders 0-4).
+#[allow(clippy::needless_range_loop)]
+pub fn foot_jet_with(
+    geometry: &CycloidGeometry,
+    pin_centre: [f64; 2],
+    disc_centre: [f64; 2],
+    disc_cos_sin: [f64; 2],
+    derivs: &[[f64; 2]; 5],
 ) -> Option<FootJet> {
     let g = geometry;
     let [c, s] = disc_cos_sin;
@@ -287,7 +330,7 @@ pub fn foot_jet(
         pin_centre[1] - disc_centre[1],
     ];
     let p = g.remove_rotation_mod([c * r[0] + s * r[1], -s * r[0] + c * r[1]]);
-    let [c0, c1, c2, c3, _] = centre_curve_derivatives(g, phi);
+    let [c0, c1, c2, c3, _] = *derivs;
     let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
     let perp = |a: [f64; 2]| [-a[1], a[0]];
     let cp = [c0[0] - p[0], c0[1] - p[1]];
@@ -387,11 +430,35 @@ pub fn line_jet(
     disc: &crate::contact::Material,
     ln_guess: f64,
 ) -> Result<LineJet> {
-    use crate::contact::line_contact::LineContactLaw;
-    let law = LineContactLaw::cycloid_contact(geometry, phi, pin_radius, depth, pin, disc)?;
-    let (force, stiffness, ln_force) = law.force_and_stiffness_from(pen, ln_guess);
-    let [kc, kc1, kc2] = centre_curvature_derivatives(geometry, phi);
+    let d = centre_curve_derivatives(geometry, phi);
+    line_jet_with(geometry, &d, pen, pin_radius, depth, pin, disc, ln_guess)
+}
+
+/// As [`line_jet`] with the curve derivatives at the contact given (orders 0-4).
+#[allow(clippy::too_many_arguments)]
+pub fn line_jet_with(
+    geometry: &CycloidGeometry,
+    derivs: &[[f64; 2]; 5],
+    pen: f64,
+    pin_radius: f64,
+    depth: f64,
+    pin: &crate::contact::Material,
+    disc: &crate::contact::Material,
+    ln_guess: f64,
+) -> Result<LineJet> {
+    use crate::contact::line_contact::{LineContactLaw, pin_disc_profile_curvature};
+    let [kc, kc1, kc2] = curvature_derivatives_of(derivs);
     let r = geometry.generating_pin_radius();
+    let kp = pin_disc_profile_curvature(kc, r)?;
+    let law = LineContactLaw::pin_disc(
+        pin_radius,
+        kp,
+        depth,
+        geometry.params().face_width,
+        pin,
+        disc,
+    )?;
+    let (force, stiffness, ln_force) = law.force_and_stiffness_from(pen, ln_guess);
     let den = 1.0 - r * kc;
     let k2 = kc / den;
     let dk2 = kc1 / (den * den);

@@ -23,7 +23,9 @@ use std::f64::consts::TAU;
 
 use crate::contact::ImpactLaw;
 use crate::contact::law::{MeshLaw, PinLaw};
-use crate::contact::pin_tangent::{GapJet, foot_jet, gap_jet_cs, line_jet};
+use crate::contact::pin_tangent::{
+    GapJet, centre_curve_derivatives_cs, foot_jet_with, gap_jet_cs, line_jet, line_jet_with,
+};
 use crate::dynamics::model::laws::{BearingLaw, ContactLaw};
 use crate::dynamics::rigid::RigidModel;
 use crate::dynamics::scene::{Joints, Scene};
@@ -594,9 +596,11 @@ impl Statics {
                             // Q = F grad g - U_phi grad phi,
                             // K = k_t gg^T - U_dphi (g phi^T + phi g^T) + U_phiphi phi phi^T
                             //     - F hess g + U_phi hess phi (docs/model.md).
-                            let lj = line_jet(
+                            // The curve's derivatives at the contact, once for both jets.
+                            let cd = centre_curve_derivatives_cs(&d.geometry, jet.phi_cos_sin);
+                            let lj = line_jet_with(
                                 &d.geometry,
-                                jet.phi,
+                                &cd,
                                 pen,
                                 pin.radius,
                                 d.body_depth,
@@ -605,15 +609,14 @@ impl Statics {
                                 self.ln_warm[slot],
                             )?;
                             self.ln_warm[slot] = lj.ln_force;
-                            let fj = foot_jet(&d.geometry, pin.centre, o, cs, jet.phi).ok_or_else(
-                                || {
+                            let fj = foot_jet_with(&d.geometry, pin.centre, o, cs, &cd)
+                                .ok_or_else(|| {
                                     RvdynError::Convergence(format!(
                                         "pin {} on disc {k}: no unique contact point on the \
                                          profile (the disc is far from any sensible pose)",
                                         j + 1
                                     ))
-                                },
-                            )?;
+                                })?;
                             f = lj.force;
                             let u_phi = lj.energy_per_phi();
                             for a in 0..3 {
