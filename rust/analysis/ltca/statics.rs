@@ -221,6 +221,29 @@ pub struct Statics {
 impl Statics {
     /// Build from a scene (validated by the model).
     pub fn new(scene: &Scene) -> Result<Self> {
+        // Errors the statics do not model yet: say so rather than analyse another reducer.
+        let unsupported = if scene.discs.iter().any(|d| {
+            d.profile_error
+                .as_ref()
+                .is_some_and(|p| !p.harmonics.is_empty() || !p.table.is_empty())
+        }) {
+            Some("disc profile errors (discs[k].profile_error)")
+        } else if scene.gear_errors.any() {
+            Some("gear runout and pitch errors (gear_errors)")
+        } else if scene.errors.any() {
+            Some(
+                "assembly errors (errors: crank eccentricity and phase, disc holes, carrier seats)",
+            )
+        } else {
+            None
+        };
+        if let Some(what) = unsupported {
+            return Err(RvdynError::Scene(format!(
+                "the quasi-static analysis (LTCA, modes) does not include {what} yet: remove \
+                 them from the scene for this analysis (pin errors and profile modifications \
+                 are included)"
+            )));
+        }
         let mut rigid_scene = scene.clone();
         rigid_scene.joints = Joints::Rigid;
         let model = RigidModel::new(&rigid_scene)?;

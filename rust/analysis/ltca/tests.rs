@@ -443,3 +443,31 @@ fn cpu_time_report() {
         lp * 1e3
     );
 }
+
+/// Errors the statics do not model are refused with a `SceneError` naming them (the LTCA does
+/// not silently analyse the error-free reducer instead).
+#[test]
+fn unsupported_errors_are_named() {
+    use crate::dynamics::scene::ProfileError;
+    let base = Scene::physical("rated").unwrap();
+    let mut profile = base.clone();
+    profile.discs[0].profile_error = Some(ProfileError {
+        harmonics: vec![[1e-6, 3.0, 0.0]],
+        table: vec![],
+    });
+    let mut gear = base.clone();
+    gear.gear_errors.sun.runout = 1e-6;
+    let mut assembly = base.clone();
+    assembly.errors.crank_eccentricity = vec![1e-6, 0.0, 0.0];
+    for (s, what) in [
+        (profile, "profile_error"),
+        (gear, "gear_errors"),
+        (assembly, "crank eccentricity"),
+    ] {
+        match Ltca::new(&s) {
+            Err(RvdynError::Scene(m)) => assert!(m.contains(what), "{m}"),
+            other => panic!("{what}: expected a SceneError, got {:?}", other.err()),
+        }
+    }
+    assert!(Ltca::new(&base).is_ok());
+}
