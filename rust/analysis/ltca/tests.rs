@@ -471,3 +471,23 @@ fn unsupported_errors_are_named() {
     }
     assert!(Ltca::new(&base).is_ok());
 }
+
+/// Where a loaded line contact sits at the line law's depth switch (`kappa_P h = 1`), its
+/// location force jumps and no equilibrium exists (physical preset, `d_rp = -20 um`, crank
+/// angle 2.3082 rad): the error names the pin and says what to do; 1e-3 rad away it solves.
+#[test]
+fn a_contact_at_the_depth_switch_is_explained() {
+    let mut s = Scene::physical("rated").unwrap();
+    s.cycloid.d_rp = -2e-5;
+    let mut ltca = Ltca::new(&s).unwrap();
+    let psi = 2.308_197_935_762_501;
+    match ltca.solve(rated(), psi) {
+        Err(RvdynError::Convergence(m)) => assert!(m.contains("reference depth"), "{m}"),
+        other => panic!(
+            "expected a ConvergenceError, got {:?}",
+            other.map(|p| p.residual)
+        ),
+    }
+    ltca.reset();
+    assert!(ltca.solve(rated(), psi + 1e-3).is_ok());
+}
