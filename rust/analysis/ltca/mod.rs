@@ -520,6 +520,31 @@ impl Ltca {
         })
     }
 
+    /// The equilibrium at a torque `t` near zero (`|t|` far below `rated`): directly, or if
+    /// that fails (bodies floating in their clearances make the start from the kinematic pose
+    /// hard) by continuation from `1e-2 rated` on the same side down by factors of 10, each
+    /// step warm-started from the last.
+    fn solve_near_zero(
+        &mut self,
+        t: f64,
+        psi: f64,
+        rated: f64,
+    ) -> Result<(Vec<f64>, NewtonReport)> {
+        match self.solve_unknowns(t, psi) {
+            Ok(r) => Ok(r),
+            Err(e) => {
+                self.reset();
+                let mut level = 1e-2 * rated;
+                while level > t.abs() * 10.0 {
+                    self.solve_unknowns(level * t.signum(), psi)
+                        .map_err(|_| e.clone())?;
+                    level *= 0.1;
+                }
+                self.solve_unknowns(t, psi).map_err(|_| e)
+            }
+        }
+    }
+
     /// The torque-twist loop at crank angle `psi`: `points` torques along
     /// 0 -> +rated -> -rated -> 0 with rigidity, lost motion and backlash (catalogue
     /// definitions, docs/model.md).
@@ -560,7 +585,11 @@ impl Ltca {
             if t != 0.0 {
                 side = t.signum();
             }
-            let (q, _) = self.solve_unknowns(ts, psi)?;
+            let (q, _) = if t == 0.0 {
+                self.solve_near_zero(ts, psi, rated)?
+            } else {
+                self.solve_unknowns(ts, psi)?
+            };
             solved.push((ts, q.clone()));
             let x = self.statics.full(psi, &q);
             // Twist positive with positive torque: the load turns the output backwards.
@@ -581,6 +610,9 @@ impl Ltca {
                     torque: *t0,
                     q: q0.clone(),
                 });
+            }
+            if t.abs() < 1e-6 * rated {
+                self.solve_near_zero(t, psi, rated)?;
             }
             let (_, dev) = self.output_angle(t, psi)?;
             Ok(-dev)
