@@ -491,3 +491,47 @@ fn a_contact_at_the_depth_switch_is_explained() {
     ltca.reset();
     assert!(ltca.solve(rated(), psi + 1e-3).is_ok());
 }
+
+/// A torque-twist loop whose zero-torque point Newton cannot reach from the kinematic pose
+/// (physical preset with pin radius errors and modifications, sample 428 of the 10 000-sample
+/// study in BENCHMARKS.md 13.1: the bodies float in the bearing clearances, some pins are
+/// preloaded) is completed by continuation from 1e-2 rated; its catalogue figures are finite
+/// and ordered.
+#[test]
+fn zero_torque_limit_by_continuation() {
+    let mut s = Scene::physical("rated").unwrap();
+    s.cycloid.d_rrp = -2.564_952_275_363_655e-7;
+    s.cycloid.d_rp = -2.826_951_413_145_57e-6;
+    s.pin_errors.radius = vec![
+        -1.112_599_373_492_489_8e-6,
+        -1.768_539_243_792_398_7e-6,
+        -4.777_438_123_914_611_5e-6,
+        4.882_652_362_319_679e-6,
+        3.248_265_596_608_798e-7,
+        7.882_658_047_440_166e-7,
+        7.256_710_737_919_903e-8,
+        4.080_799_420_314_174e-6,
+        1.120_731_849_109_812_7e-6,
+        -1.091_075_135_946_992_7e-6,
+        -2.217_840_467_851_037e-6,
+        -2.972_824_126_105_944e-6,
+        1.220_949_778_776_095_2e-6,
+        4.023_083_627_160_912e-6,
+        3.308_289_345_363_807_4e-6,
+        -4.250_067_239_665_637e-6,
+        4.638_259_778_539_203e-6,
+        1.629_894_266_273_321e-6,
+        -2.161_710_383_519_091e-6,
+        -1.177_098_475_687_473e-6,
+        1.468_255_901_030_791_3e-6,
+        2.079_780_955_800_177_2e-6,
+        -3.084_438_091_951_610_5e-6,
+        -2.806_222_544_910_242e-6,
+    ];
+    // (Without the continuation this loop fails: Newton from the kinematic pose at 1e-7
+    // rated stalls after 200 iterations.)
+    let mut ltca = Ltca::new(&s).unwrap();
+    let lp = ltca.twist_loop(rated(), 0.0, 41).unwrap();
+    assert!(lp.rigidity > 0.0 && lp.backlash >= 0.0 && lp.lost_motion > lp.backlash);
+    assert!(lp.twist.iter().all(|v| v.is_finite()));
+}
