@@ -83,6 +83,19 @@ impl ContactDamping {
     }
 }
 
+impl ContactDamping {
+    /// Damping coefficient `dF/d(rate)` [N s/m] at zero rate for the elastic force `elastic`
+    /// [N] and its tangent stiffness `stiffness` [N/m] (0 without contact): the contact's part
+    /// of a linearised damping matrix.
+    #[inline]
+    pub fn rate_coefficient(&self, elastic: f64, stiffness: f64) -> f64 {
+        match self {
+            Self::Hysteresis(h) => h.force_and_derivatives(elastic, stiffness, 0.0).2,
+            Self::Proportional(p) => p.force_and_derivatives(elastic, stiffness, 0.0, 0.0).2,
+        }
+    }
+}
+
 /// The steel of the paper's scene (`E = 2.17e11 Pa`, `nu = 0.3`) for serde defaults.
 pub fn default_youngs_modulus() -> f64 {
     2.17e11

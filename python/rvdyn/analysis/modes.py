@@ -241,7 +241,10 @@ def _as_list(values: Sequence[float] | np.ndarray) -> list[float]:
 def add_cli_arguments(p: Any) -> None:
     """Arguments of ``rvdyn modes``."""
     p.add_argument("scene", nargs="?", default=None,
-                   help="scene file (.json or .toml); default: the paper's scene at rated load")
+                   help="scene file (.json or .toml); default: the preset chosen by --preset at rated load")
+    p.add_argument("--preset", choices=("physical", "paper"), default="physical",
+                   help="preset used without a scene file (default physical: line-contact pins, ISO "
+                   "6336 meshes, roller bearings; paper: the paper's IMPACT laws, rigid joints)")
     p.add_argument("--compliant", action="store_true",
                    help="use the default compliant joints (bearings) instead of the scene's joints")
     p.add_argument("--torque", type=float, default=None, metavar="NM",
@@ -270,7 +273,10 @@ def run_cli(args: Any) -> int:
     from ..scene import Scene
     from .campbell import campbell
 
-    scene = Scene.paper("rated") if args.scene is None else Scene.load(args.scene)
+    if args.scene is not None:
+        scene = Scene.load(args.scene)
+    else:
+        scene = Scene.physical("rated") if args.preset == "physical" else Scene.paper("rated")
     if args.compliant:
         scene = scene.with_compliant_joints()
     os.makedirs(args.out, exist_ok=True)

@@ -101,6 +101,9 @@ impl Linearizer {
             ramp_time: 0.0,
         };
         free_scene.load = Load::Idle;
+        // Only forces are evaluated: the initial state does not matter (and a steady start
+        // needs a speed drive).
+        free_scene.initial = crate::dynamics::scene::Initial::Rest;
         let full = full_names(&statics);
         let (names, mass, dynamic) = match scene.joints {
             Joints::Rigid => {
