@@ -641,8 +641,11 @@ impl Ltca {
 /// identical pins the pattern repeats every `2 pi / zp` of crank angle (both discs at once:
 /// their phases only shift the pattern). Pin errors make pins distinguishable: a pin returns to
 /// the same lobe position only after the shift is a whole number of rings, `2 pi` of crank
-/// angle. An IMPACT mesh law does not vary with the tooth position; the ISO 6336 stiffness
-/// varies with the mesh position `s = r_bs (th_s - th_c)` with the period of one base pitch,
+/// angle. A disc profile error makes the lobes distinguishable: the turned assembly matches
+/// only when the disc has turned by the same whole-ring angle, after `2 pi zc / zp` of crank
+/// angle (`2 pi zc` with pin errors too). An IMPACT mesh law does not vary
+/// with the tooth position; the ISO 6336 stiffness varies with the mesh position
+/// `s = r_bs (th_s - th_c)` with the period of one base pitch,
 /// which the held sun passes every `2 pi zc / (z_planet zp)` of crank angle
 /// (`th_s - th_c = -(z_planet / z_sun)(1 + 1/zc) psi` with the input held): the pattern then
 /// repeats after the least common multiple of both periods, counted in units of
@@ -652,7 +655,19 @@ pub fn mesh_period(scene: &Scene) -> f64 {
     let errors =
         e.position.iter().any(|p| p[0] != 0.0 || p[1] != 0.0) || e.radius.iter().any(|r| *r != 0.0);
     let zp = u64::from(scene.cycloid.pins);
-    let pins = if errors { TAU } else { TAU / zp as f64 };
+    // Whole pin pitches (of 2 pi / zp crank angle) after which the pattern repeats.
+    let lobes = scene.discs.iter().any(|d| {
+        d.profile_error
+            .as_ref()
+            .is_some_and(|p| !p.harmonics.is_empty() || !p.table.is_empty())
+    });
+    let pitches = match (errors, lobes) {
+        (false, false) => 1,
+        (true, false) => zp,
+        (false, true) => zp - 1,
+        (true, true) => zp * (zp - 1),
+    };
+    let pins = TAU * pitches as f64 / zp as f64;
     let iso = matches!(
         scene.contact.mesh,
         crate::dynamics::scene::ContactLawSpec::Iso6336 { .. }
@@ -661,7 +676,7 @@ pub fn mesh_period(scene: &Scene) -> f64 {
         (Some(st), true) => {
             let zpl = u64::from(st.z_planet);
             let unit = TAU / (zpl * zp) as f64;
-            let pin_units = if errors { zpl * zp } else { zpl };
+            let pin_units = zpl * pitches;
             let mesh_units = zp - 1;
             let gcd = |mut a: u64, mut b: u64| {
                 while b != 0 {

@@ -28,7 +28,7 @@ use crate::contact::pin_tangent::{
 };
 use crate::dynamics::model::laws::{BearingLaw, ContactLaw};
 use crate::dynamics::rigid::RigidModel;
-use crate::dynamics::scene::{Joints, Scene};
+use crate::dynamics::scene::{Joints, ProfileError, Scene};
 use crate::error::{Result, RvdynError};
 use crate::geometry::gap::small_sin_cos;
 
@@ -125,7 +125,8 @@ pub struct ContactState {
     /// The gap jets (contact point, normal, curvature) per disc and pin.
     pub pin_jet: Vec<GapJet>,
     /// Moment about the reducer axis of the line law's location term on each disc, per disc
-    /// and pin [N m] (0 for IMPACT): `O x Q_O + Q_theta` of `Q = -U_phi grad phi`.
+    /// and pin [N m] (0 for IMPACT): `O x Q_O + Q_theta` of `Q = -U_phi grad phi`, plus the
+    /// same moment of a profile error's share `-F delta' grad phi`.
     pub pin_location_moment: Vec<f64>,
     /// Sum over the bearings of the couple `d x F` of each bearing's force pair [N m]: zero
     /// for an isotropic law (force along the deflection); the roller laws, with their roller
@@ -216,19 +217,17 @@ pub struct Statics {
     pin_dirs: Vec<[f64; 2]>,
     /// Largest distance of a profile point from its disc centre [m].
     reach: f64,
+    /// Bound of each disc's profile error `|delta| <= bound` [m] (0 without one): the
+    /// separation skip keeps `gap - bound` (the error-free gap less the bound is below the gap
+    /// with the error, whatever the foot).
+    error_bound: Vec<f64>,
 }
 
 impl Statics {
     /// Build from a scene (validated by the model).
     pub fn new(scene: &Scene) -> Result<Self> {
         // Errors the statics do not model yet: say so rather than analyse another reducer.
-        let unsupported = if scene.discs.iter().any(|d| {
-            d.profile_error
-                .as_ref()
-                .is_some_and(|p| !p.harmonics.is_empty() || !p.table.is_empty())
-        }) {
-            Some("disc profile errors (discs[k].profile_error)")
-        } else if scene.gear_errors.any() {
+        let unsupported = if scene.gear_errors.any() {
             Some("gear runout and pitch errors (gear_errors)")
         } else if scene.errors.any() {
             Some(
@@ -240,8 +239,8 @@ impl Statics {
         if let Some(what) = unsupported {
             return Err(RvdynError::Scene(format!(
                 "the quasi-static analysis (LTCA, modes) does not include {what} yet: remove \
-                 them from the scene for this analysis (pin errors and profile modifications \
-                 are included)"
+                 them from the scene for this analysis (pin errors, disc profile errors and \
+                 profile modifications are included)"
             )));
         }
         let mut rigid_scene = scene.clone();
@@ -340,6 +339,16 @@ impl Statics {
                 })
                 .fold(0.0, f64::max)
                 * 1.000_001,
+            error_bound: model
+                .discs
+                .iter()
+                .map(|d| {
+                    d.profile_error.as_ref().map_or(0.0, |p| {
+                        p.harmonics.iter().map(|h| h[0].abs()).sum::<f64>()
+                            + p.table.iter().map(|t| t[1].abs()).fold(0.0, f64::max)
+                    })
+                })
+                .collect(),
             model,
         })
     }
@@ -570,6 +579,8 @@ impl Statics {
                     let b = &self.separation[slot];
                     b.0 == o && b.1 == th && b.2.is_finite()
                 };
+                // `jet` is the error-free gap (the one kept for reuse); the disc's profile
+                // error enters below.
                 let jet = if same {
                     self.last_jets[slot]
                 } else {
@@ -592,10 +603,31 @@ impl Statics {
                     let off = jet.phi - kin;
                     *w = if off.abs() < 0.01 { off } else { 0.0 };
                     if self.skip {
-                        self.separation[slot] = (o, th, jet.gap);
+                        self.separation[slot] = (o, th, jet.gap - self.error_bound[k]);
                         self.last_jets[slot] = jet;
                     }
                     jet
+                };
+                // Profile error: gap' = gap - delta(phi(q)) (the dynamic models' first-order
+                // offset at the foot), grad' = grad - delta' grad phi,
+                // hess' = hess - delta'' grad phi grad phi^T - delta' hess phi.
+                let (jet, err) = match &d.profile_error {
+                    Some(pe) => {
+                        let cd = centre_curve_derivatives_cs(&d.geometry, jet.phi_cos_sin);
+                        let fj = foot_jet_with(&d.geometry, pin.centre, o, cs, &cd)
+                            .ok_or_else(|| no_foot(k, j))?;
+                        let (delta, d1, d2) = profile_offset_jet(pe, jet.phi);
+                        let mut e = jet;
+                        e.gap -= delta;
+                        for a in 0..3 {
+                            e.grad[a] -= d1 * fj.grad[a];
+                            for b in 0..3 {
+                                e.hess[a][b] -= d2 * fj.grad[a] * fj.grad[b] + d1 * fj.hess[a][b];
+                            }
+                        }
+                        (e, Some((cd, fj, d1)))
+                    }
+                    None => (jet, None),
                 };
                 let pen = -jet.gap;
                 self.max_penetration = self.max_penetration.max(pen);
@@ -620,7 +652,10 @@ impl Statics {
                             // K = k_t gg^T - U_dphi (g phi^T + phi g^T) + U_phiphi phi phi^T
                             //     - F hess g + U_phi hess phi (docs/model.md).
                             // The curve's derivatives at the contact, once for both jets.
-                            let cd = centre_curve_derivatives_cs(&d.geometry, jet.phi_cos_sin);
+                            let cd = match &err {
+                                Some((cd, ..)) => *cd,
+                                None => centre_curve_derivatives_cs(&d.geometry, jet.phi_cos_sin),
+                            };
                             let lj = line_jet_with(
                                 &d.geometry,
                                 &cd,
@@ -632,14 +667,11 @@ impl Statics {
                                 self.ln_warm[slot],
                             )?;
                             self.ln_warm[slot] = lj.ln_force;
-                            let fj = foot_jet_with(&d.geometry, pin.centre, o, cs, &cd)
-                                .ok_or_else(|| {
-                                    RvdynError::Convergence(format!(
-                                        "pin {} on disc {k}: no unique contact point on the \
-                                         profile (the disc is far from any sensible pose)",
-                                        j + 1
-                                    ))
-                                })?;
+                            let fj = match &err {
+                                Some((_, fj, _)) => *fj,
+                                None => foot_jet_with(&d.geometry, pin.centre, o, cs, &cd)
+                                    .ok_or_else(|| no_foot(k, j))?,
+                            };
                             f = lj.force;
                             let u_phi = lj.energy_per_phi();
                             for a in 0..3 {
@@ -680,6 +712,14 @@ impl Statics {
                     }
                 }
                 if let Some(s) = state.as_deref_mut() {
+                    // The profile error's share of the force, -F delta' grad phi on the
+                    // disc, is off the normal: its moment about the axis, as the location
+                    // term's.
+                    if let Some((_, fj, d1)) = &err {
+                        let w = f * d1;
+                        s.pin_location_moment[slot] -=
+                            w * (o[0] * fj.grad[1] - o[1] * fj.grad[0] + fj.grad[2]);
+                    }
                     s.pin_force[k * zp + j] = f;
                     s.pin_gap[k * zp + j] = jet.gap;
                     s.pin_jet.push(jet);
@@ -984,6 +1024,28 @@ impl Statics {
     }
 }
 
+/// The error of a pin query whose foot is not unique.
+fn no_foot(k: usize, j: usize) -> RvdynError {
+    RvdynError::Convergence(format!(
+        "pin {} on disc {k}: no unique contact point on the profile (the disc is far from any \
+         sensible pose)",
+        j + 1
+    ))
+}
+
+/// A disc profile error's offset `delta(phi)` [m] with its first and second derivatives
+/// [m/rad, m/rad^2] (the table is piecewise linear: no second derivative between its points;
+/// at a point the slope jumps and the tangent is one-sided).
+fn profile_offset_jet(pe: &ProfileError, phi: f64) -> (f64, f64, f64) {
+    let (d, d1) = pe.offset(phi);
+    let d2 = pe
+        .harmonics
+        .iter()
+        .map(|h| -h[0] * h[1] * h[1] * (h[1] * phi + h[2]).cos())
+        .sum();
+    (d, d1, d2)
+}
+
 /// Scratch space of [`Statics::eval`].
 #[derive(Debug, Clone)]
 pub struct Work {
@@ -1157,7 +1219,26 @@ mod tests {
         single_c.joints = crate::dynamics::compliant::default_joints();
         out.push(single_c);
         out.extend(physical_scenes());
+        // Disc profile errors (harmonics and a table) at rigid and compliant joints.
+        let mut pe = m.clone();
+        with_profile_errors(&mut pe);
+        out.push(pe.clone());
+        pe.joints = crate::dynamics::compliant::default_joints();
+        out.push(pe);
         out
+    }
+
+    /// Disc profile errors of a few um on both discs: harmonics of several orders and a
+    /// periodic table on disc 0.
+    fn with_profile_errors(s: &mut Scene) {
+        s.discs[0].profile_error = Some(ProfileError {
+            harmonics: vec![[3e-6, 23.0, 0.4], [2e-6, 2.0, 1.0]],
+            table: vec![[0.0, 1e-6], [2.0, -1e-6], [4.0, 5e-7]],
+        });
+        s.discs[1].profile_error = Some(ProfileError {
+            harmonics: vec![[2e-6, 46.0, 1.3], [1e-6, 1.0, 0.0]],
+            table: vec![],
+        });
     }
 
     /// The physical preset (line law, ISO mesh, roller bearings with clearance), modified,
@@ -1178,6 +1259,12 @@ mod tests {
         out.push(c);
         let mut r = m;
         r.joints = Joints::Rigid;
+        out.push(r.clone());
+        // Line law with disc profile errors, compliant and rigid joints.
+        let mut pe = base.clone();
+        with_profile_errors(&mut pe);
+        out.push(pe);
+        with_profile_errors(&mut r);
         out.push(r);
         out
     }
@@ -1336,44 +1423,49 @@ mod tests {
     }
 
     /// Skipping pins that provably cannot touch changes no force or stiffness: along a loaded
-    /// sweep, the skipping evaluator and one that queries every pin agree to round-off.
+    /// sweep, the skipping evaluator and one that queries every pin agree to round-off (also
+    /// with disc profile errors, where the bound keeps `gap - max |delta|`).
     #[test]
     fn skipping_separated_pins_gives_the_same_forces() {
         let mut scene = Scene::paper("rated").unwrap();
         scene.cycloid.d_rrp = 2e-5;
         scene.cycloid.d_rp = -2e-5;
         scene.joints = crate::dynamics::compliant::default_joints();
-        let mut skipping = Statics::new(&scene).unwrap();
-        let mut fresh = Statics::new(&scene).unwrap();
-        fresh.skip = false;
-        let n = skipping.dim();
-        let (mut r1, mut r2) = (vec![0.0; n], vec![0.0; n]);
-        let (mut k1, mut k2) = (Dense::zeros(n), Dense::zeros(n));
-        let mut work = Work::new();
-        let mut rnd = rng(5);
-        let mut worst: f64 = 0.0;
-        let mut skipped = 0;
-        for i in 0..200 {
-            let psi = 0.002 * i as f64;
-            let mut q = skipping.kinematic_unknowns(psi);
-            q[0] -= 2e-4 + 1e-5 * rnd();
-            let mut cs = ContactState::default();
-            skipping
-                .eval(psi, &q, 4e4, &mut r1, &mut k1, &mut work, Some(&mut cs))
-                .unwrap();
-            fresh
-                .eval(psi, &q, 4e4, &mut r2, &mut k2, &mut work, None)
-                .unwrap();
-            for a in 0..n {
-                worst = worst.max((r1[a] - r2[a]).abs() / skipping.scale[a]);
-                for b in 0..n {
-                    worst = worst.max((k1.at(a, b) - k2.at(a, b)).abs() * 1e-9);
+        let mut with_errors = scene.clone();
+        with_profile_errors(&mut with_errors);
+        for scene in [scene, with_errors] {
+            let mut skipping = Statics::new(&scene).unwrap();
+            let mut fresh = Statics::new(&scene).unwrap();
+            fresh.skip = false;
+            let n = skipping.dim();
+            let (mut r1, mut r2) = (vec![0.0; n], vec![0.0; n]);
+            let (mut k1, mut k2) = (Dense::zeros(n), Dense::zeros(n));
+            let mut work = Work::new();
+            let mut rnd = rng(5);
+            let mut worst: f64 = 0.0;
+            let mut skipped = 0;
+            for i in 0..200 {
+                let psi = 0.002 * i as f64;
+                let mut q = skipping.kinematic_unknowns(psi);
+                q[0] -= 2e-4 + 1e-5 * rnd();
+                let mut cs = ContactState::default();
+                skipping
+                    .eval(psi, &q, 4e4, &mut r1, &mut k1, &mut work, Some(&mut cs))
+                    .unwrap();
+                fresh
+                    .eval(psi, &q, 4e4, &mut r2, &mut k2, &mut work, None)
+                    .unwrap();
+                for a in 0..n {
+                    worst = worst.max((r1[a] - r2[a]).abs() / skipping.scale[a]);
+                    for b in 0..n {
+                        worst = worst.max((k1.at(a, b) - k2.at(a, b)).abs() * 1e-9);
+                    }
                 }
+                skipped = skipping.skipped;
             }
-            skipped = skipping.skipped;
+            assert!(worst == 0.0, "skipping changes the forces by {worst:e}");
+            assert!(skipped > 1000, "{skipped}");
         }
-        assert!(worst == 0.0, "skipping changes the forces by {worst:e}");
-        assert!(skipped > 1000, "{skipped}");
     }
 
     /// The tangent stiffness equals central differences of the static forces.
