@@ -5,11 +5,15 @@
 //! cargo build --release --example count_work
 //! valgrind --tool=callgrind target/release/examples/count_work run 0.02 generalized-alpha rigid
 //! valgrind --tool=callgrind target/release/examples/count_work rhs 20000   # minus `rhs 0`
+//! valgrind --tool=callgrind target/release/examples/count_work phys 20000  # minus `phys 0`
 //! ```
 //!
 //! `run T METHOD JOINTS`: `dynamics::simulate` of the rated default scene for T s with no
 //! channels recorded (JOINTS `rigid` or `compliant`); `rhs N`: N force evaluations of the
-//! rigid rated scene at one loaded state (after 0.05 s from rest).
+//! rigid rated scene at one loaded state (after 0.05 s from rest); `phys N`: N force evaluations of
+//! the physical rated preset (compliant roller bearings) at one loaded state (after 0.1 s from
+//! rest).
+use rvdyn::dynamics::compliant::CompliantModel;
 use rvdyn::dynamics::model::ReducerModel;
 use rvdyn::dynamics::system::RigidSystem;
 use rvdyn::dynamics::{RigidModel, RunControl, Scene, SimOptions, simulate};
@@ -21,6 +25,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let arg = |i: usize, default: &str| args.get(i).cloned().unwrap_or_else(|| default.into());
     let mut scene = Scene::paper("rated")?;
+    if arg(1, "run") == "phys" {
+        let n: usize = arg(2, "20000").parse()?;
+        let model = CompliantModel::new(&Scene::physical("rated")?)?;
+        let (q, v) = model.initial_state();
+        let mut st = State::new(&model, 0.0, q, v)?;
+        let mut ga = GeneralizedAlpha::new(0.8, 1e-9, false)?;
+        for _ in 0..5000 {
+            ga.step(&model, &mut st, 2e-5)?;
+        }
+        let a = eval_loop(&model, &st, n)?;
+        println!("{n} evaluations, a = {a:?}");
+        return Ok(());
+    }
     if arg(1, "run") == "rhs" {
         let n: usize = arg(2, "20000").parse()?;
         let model = RigidModel::new(&scene)?;
@@ -54,4 +71,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let r = simulate(&scene, &opt, &RunControl::default())?;
     println!("{} samples, stats {:?}", r.samples, r.stats);
     Ok(())
+}
+
+/// `n` evaluations of `sys` at `st` (kept out of line so that a profiler can collect this
+/// function alone: `--toggle-collect='*eval_loop*'`).
+#[inline(never)]
+fn eval_loop<S: MechanicalSystem>(sys: &S, st: &State, n: usize) -> rvdyn::Result<Vec<f64>> {
+    let (mut a, mut p) = (vec![0.0; sys.dof()], [0.0; 3]);
+    for _ in 0..n {
+        sys.eval(
+            black_box(st.t),
+            black_box(&st.q),
+            black_box(&st.v),
+            &mut a,
+            &mut p,
+        )?;
+    }
+    Ok(a)
 }
