@@ -8,8 +8,9 @@
 //! valgrind --tool=callgrind target/release/examples/count_work phys 20000  # minus `phys 0`
 //! ```
 //!
-//! `run T METHOD JOINTS`: `dynamics::simulate` of the rated default scene for T s with no
-//! channels recorded (JOINTS `rigid` or `compliant`); `rhs N`: N force evaluations of the
+//! `run T METHOD JOINTS [record]`: `dynamics::simulate` of the rated default scene for T s with
+//! no channels recorded (JOINTS `rigid` or `compliant`), or with `record` the default channels
+//! at every step; `rhs N`: N force evaluations of the
 //! rigid rated scene at one loaded state (after 0.05 s from rest); `phys N`: N force evaluations of
 //! the physical rated preset (compliant roller bearings) at one loaded state (after 0.1 s from
 //! rest).
@@ -67,7 +68,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         scene.joints = rvdyn::dynamics::compliant::default_joints();
     }
     let mut opt = SimOptions::new(t_end, method);
-    opt.channels = vec![];
+    if arg(5, "") == "record" {
+        // The default channels at every step (record interval = the step).
+        opt.record_interval = Some(SimOptions::default_dt(method));
+    } else {
+        opt.channels = vec![];
+    }
     let r = simulate(&scene, &opt, &RunControl::default())?;
     println!("{} samples, stats {:?}", r.samples, r.stats);
     Ok(())
