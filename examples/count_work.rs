@@ -8,9 +8,9 @@
 //! valgrind --tool=callgrind target/release/examples/count_work phys 20000  # minus `phys 0`
 //! ```
 //!
-//! `run T METHOD JOINTS [record]`: `dynamics::simulate` of the rated default scene for T s with
-//! no channels recorded (JOINTS `rigid` or `compliant`), or with `record` the default channels
-//! at every step; `rhs N`: N force evaluations of the
+//! `run T METHOD JOINTS [record|-] [ATOL RTOL]`: `dynamics::simulate` of the rated default
+//! scene for T s with no channels recorded (JOINTS `rigid`, `compliant`, or `physical` for the
+//! physical preset), or with `record` the default channels at every step; `rhs N`: N force evaluations of the
 //! rigid rated scene at one loaded state (after 0.05 s from rest); `phys N`: N force evaluations of
 //! the physical rated preset (compliant roller bearings) at one loaded state (after 0.1 s from
 //! rest).
@@ -64,10 +64,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let t_end: f64 = arg(2, "0.02").parse()?;
     let method = Method::parse(&arg(3, "generalized-alpha"))?;
+    if arg(4, "rigid") == "physical" {
+        scene = Scene::physical("rated")?;
+    }
     if arg(4, "rigid") == "compliant" {
         scene.joints = rvdyn::dynamics::compliant::default_joints();
     }
     let mut opt = SimOptions::new(t_end, method);
+    if let (Ok(atol), Ok(rtol)) = (arg(6, "").parse::<f64>(), arg(7, "").parse::<f64>()) {
+        (opt.atol, opt.rtol) = (atol, rtol);
+    }
     if arg(5, "") == "record" {
         // The default channels at every step (record interval = the step).
         opt.record_interval = Some(SimOptions::default_dt(method));
