@@ -206,7 +206,10 @@ class Scene:
 
     def model_info(self) -> dict[str, Any]:
         """Mass properties the model uses (computed ones included) [kg, kg m^2], the
-        generalised masses of (carrier, crank, sun), crank radius [m], ratio and DOF count."""
+        generalised masses of the rigid model's (carrier, crank, sun, load, motor) [kg m^2] (the
+        load and motor entries are coordinates only with ``shafts.output`` / ``shafts.input``;
+        without them the load inertia is in the carrier's and the motor inertia in the sun's),
+        crank radius [m], ratio and DOF count."""
         return dict(self._compiled.model_info())
 
     @property

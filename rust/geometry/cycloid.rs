@@ -71,6 +71,118 @@ pub fn check_pin_radii(pin_radius: f64, errors: &[f64]) -> Result<()> {
     Ok(())
 }
 
+/// Profile error of a disc: a normal offset `delta(phi)` of the ground profile [m] as a function
+/// of the curve parameter `phi` (rad; the polar angle of the pin-centre curve point in the
+/// disc frame, before the rotation modification), positive = material added (outward), so
+/// that every gap shrinks by `delta` at the contact (the opposite sign of `d_rrp`: a constant
+/// offset `a` is the equidistant modification `d_rrp = -a`). The sum of harmonics
+/// `a cos(n phi + p)` and a periodic table, each optional.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProfileError {
+    /// `[amplitude [m], order n (integer >= 0), phase p [rad]]` of each harmonic
+    /// `a cos(n phi + p)`.
+    #[serde(default)]
+    pub harmonics: Vec<[f64; 3]>,
+    /// `[phi [rad], offset [m]]` points, `phi` strictly increasing in `[0, 2 pi)`; linear in
+    /// between and periodic (the last point joins the first across `2 pi`).
+    #[serde(default)]
+    pub table: Vec<[f64; 2]>,
+}
+
+impl ProfileError {
+    /// Largest `|delta|` the model accepts, as a fraction of the pin radius (a tenth: the
+    /// penetration bound of a run).
+    pub const LIMIT_FRACTION: f64 = 0.1;
+
+    /// Whether the error is identically zero (no harmonic and no table).
+    pub fn is_empty(&self) -> bool {
+        self.harmonics.is_empty() && self.table.is_empty()
+    }
+
+    /// Check the fields; `at` names the field (`"discs[0].profile_error"`) in the message.
+    /// Every number finite, orders non-negative integers, table angles strictly increasing in
+    /// `[0, 2 pi)`, and `sum |a| + max |table|` below `limit` [m].
+    pub fn check(&self, at: &str, limit: f64) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Scene(format!("{at}.{m}")));
+        for (i, h) in self.harmonics.iter().enumerate() {
+            if !h.iter().all(|v| v.is_finite()) {
+                return bad(format!("harmonics[{i}] must be finite numbers, got {h:?}"));
+            }
+            if !(h[1] >= 0.0 && h[1].fract() == 0.0 && h[1] <= 1e6) {
+                return bad(format!(
+                    "harmonics[{i}] order must be an integer >= 0 (the error is periodic over \
+                     the disc), got {}",
+                    h[1]
+                ));
+            }
+        }
+        for (i, p) in self.table.iter().enumerate() {
+            if !p.iter().all(|v| v.is_finite()) {
+                return bad(format!("table[{i}] must be finite numbers, got {p:?}"));
+            }
+            if !(0.0..2.0 * PI).contains(&p[0]) {
+                return bad(format!(
+                    "table[{i}] angle must be in [0, 2 pi) rad, got {}",
+                    p[0]
+                ));
+            }
+        }
+        if self.table.windows(2).any(|w| w[1][0] <= w[0][0]) {
+            return bad("table angles must increase strictly".into());
+        }
+        let size = self.harmonics.iter().map(|h| h[0].abs()).sum::<f64>()
+            + self.table.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
+        if size >= limit {
+            return bad(format!(
+                "offset bound sum |a| + max |table| = {} m must be below {} m (a tenth of the \
+                 pin radius)",
+                num(size),
+                num(limit)
+            ));
+        }
+        Ok(())
+    }
+
+    /// The offset `delta(phi)` [m] and its slope `d delta / d phi` [m/rad].
+    pub fn offset(&self, phi: f64) -> (f64, f64) {
+        let mut d = 0.0;
+        let mut s = 0.0;
+        for h in &self.harmonics {
+            let (sn, cs) = (h[1] * phi + h[2]).sin_cos();
+            d += h[0] * cs;
+            s -= h[0] * h[1] * sn;
+        }
+        let (td, ts) = periodic_table(&self.table, phi);
+        (d + td, s + ts)
+    }
+}
+
+/// Value and slope of a periodic piecewise-linear table `[x, y]` (x in `[0, 2 pi)`, strictly
+/// increasing) at `x` (any real): the last point joins the first across `2 pi`. Empty: 0.
+pub fn periodic_table(points: &[[f64; 2]], x: f64) -> (f64, f64) {
+    match points {
+        [] => (0.0, 0.0),
+        [only] => (only[1], 0.0),
+        _ => {
+            let tau = 2.0 * PI;
+            let x = x.rem_euclid(tau);
+            let n = points.len();
+            // Segment [a, b] containing x, with b wrapped across 2 pi for the last one.
+            let i = points.partition_point(|p| p[0] <= x);
+            let (a, b) = if i == 0 {
+                ([points[n - 1][0] - tau, points[n - 1][1]], points[0])
+            } else if i == n {
+                (points[n - 1], [points[0][0] + tau, points[0][1]])
+            } else {
+                (points[i - 1], points[i])
+            };
+            let slope = (b[1] - a[1]) / (b[0] - a[0]);
+            (a[1] + slope * (x - a[0]), slope)
+        }
+    }
+}
+
 /// The parameters that define a cycloid disc and its pin ring (SI units).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

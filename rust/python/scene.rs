@@ -195,11 +195,15 @@ fn model_info<'py>(py: Python<'py>, sc: &Scene) -> PyResult<Bound<'py, PyDict>> 
         d.set_item(format!("{name}_inertia"), mp.inertia)?;
     }
     d.set_item("load_inertia", i.load_inertia)?;
+    d.set_item("motor_inertia", i.motor_inertia)?;
     d.set_item("generalized_mass", model.mass.to_vec())?;
     d.set_item("crank_radius", model.crank_radius)?;
     d.set_item("ratio", model.ratio)?;
     d.set_item("max_penetration", model.max_penetration)?;
-    d.set_item("dof", dof.unwrap_or(model.free.len()))?;
+    d.set_item(
+        "dof",
+        dof.unwrap_or(model.free.len() + model.shaft_free.len()),
+    )?;
     d.set_item("joints", if dof.is_some() { "compliant" } else { "rigid" })?;
     Ok(d)
 }

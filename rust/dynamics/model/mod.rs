@@ -60,6 +60,18 @@ pub struct Observation {
     pub potential_energy: f64,
     /// Friction power [W] at the pins, the teeth and the bearings.
     pub friction_power: [f64; 3],
+    /// Load angle [rad] (the carrier's without an output shaft).
+    pub load_angle: f64,
+    /// Load speed [rad/s].
+    pub load_speed: f64,
+    /// Motor angle [rad] (the input's without a drive shaft).
+    pub motor_angle: f64,
+    /// Motor speed [rad/s].
+    pub motor_speed: f64,
+    /// Torque in the output shaft [N m] (without one: the load torque).
+    pub output_shaft_torque: f64,
+    /// Torque in the drive shaft [N m] (without one: the input torque).
+    pub input_shaft_torque: f64,
 }
 
 /// A reducer model the driver can integrate and record.

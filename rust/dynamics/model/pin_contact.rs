@@ -61,6 +61,19 @@ pub(crate) struct PinContact {
     /// Curve parameter of the contact on the profile [rad] (for laws that need the local
     /// curvature).
     pub(crate) phi: f64,
+    /// With a profile error `delta(phi)`: the derivatives of its share of the penetration,
+    /// `delta'(phi) dphi/dO` [-] (fixed frame) and `delta'(phi) dphi/dtheta` [m/rad].
+    pub(crate) error_gradient: Option<([f64; 2], f64)>,
+}
+
+impl PinContact {
+    /// Rate of the profile error's share of the penetration for the disc centre velocity
+    /// `ov` [m/s] and angular speed `w` [rad/s] (0 without an error).
+    #[inline]
+    pub(crate) fn error_rate(&self, ov: [f64; 2], w: f64) -> f64 {
+        self.error_gradient
+            .map_or(0.0, |(go, gt)| go[0] * ov[0] + go[1] * ov[1] + gt * w)
+    }
 }
 
 impl PinContact {
@@ -123,7 +136,28 @@ pub(crate) fn pin_query(
         cos_sin: foot.cos_sin,
     });
     let r_gen = g.generating_pin_radius();
-    let gap = foot.dist + r_gen - pin.radius;
+    let mut gap = foot.dist + r_gen - pin.radius;
+    // Profile error: the ground profile offset by delta(phi) along its normal shrinks the gap
+    // by delta at the foot (first order); the foot moves with the disc, so the penetration's
+    // gradient gets delta'(phi) dphi/dq (docs/model.md#manufacturing-errors-of-profile-and-gears).
+    let error_gradient = disc.profile_error.as_ref().map(|pe| {
+        let (delta, slope) = pe.offset(foot.phi);
+        gap -= delta;
+        let j = g.jet(foot.phi);
+        let gp = j.d1[0] * j.d1[0]
+            + j.d1[1] * j.d1[1]
+            + (j.c[0] - local[0]) * j.d2[0]
+            + (j.c[1] - local[1]) * j.d2[1];
+        let t = g.apply_rotation_mod(j.d1);
+        let t_global = [c * t[0] - s * t[1], s * t[0] + c * t[1]];
+        let zxp = [-local[1], local[0]];
+        // gp > 0 at a distance minimum (the foot); guard the degenerate case.
+        let k = if gp > 0.0 { slope / gp } else { 0.0 };
+        (
+            [-k * t_global[0], -k * t_global[1]],
+            -k * (j.d1[0] * zxp[0] + j.d1[1] * zxp[1]),
+        )
+    });
     let nl = g.apply_rotation_mod(foot.normal);
     let pl = g.apply_rotation_mod([
         foot.centre_point[0] - r_gen * foot.normal[0],
@@ -134,6 +168,7 @@ pub(crate) fn pin_query(
         normal: [c * nl[0] - s * nl[1], s * nl[0] + c * nl[1]],
         arm: [c * pl[0] - s * pl[1], s * pl[0] + c * pl[1]],
         phi: foot.phi,
+        error_gradient,
     })
 }
 

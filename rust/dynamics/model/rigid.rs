@@ -13,6 +13,7 @@
 //! `M_ii a_i - Q_i` on them is the input torque.
 
 use crate::contact::law::PinSite;
+use crate::dynamics::model::parts::MeshOffset;
 pub(crate) use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::pin_contact::{
     DiscPose, SeparationBound, WarmStart, penetration_error, touching_pin,
@@ -28,11 +29,18 @@ pub const CARRIER: usize = 0;
 pub const CRANK: usize = 1;
 /// Index of the sun angle.
 pub const SUN: usize = 2;
+/// Index of the load angle (a coordinate only with an output shaft).
+pub const LOAD: usize = 3;
+/// Index of the motor angle (a coordinate only with a drive shaft).
+pub const MOTOR: usize = 4;
+/// Number of full coordinates `[th_c, alpha, th_s, th_L, th_m]`.
+pub const FULL: usize = 5;
 
 /// Generalised forces and power flows from one evaluation.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Forces {
-    /// Generalised forces on `[th_c, alpha, th_s]` [N m].
+    /// Generalised forces on `[th_c, alpha, th_s]` [N m] (the shafts' on the load and motor
+    /// are added by the adapter).
     pub(crate) q: [f64; 3],
     /// Power dissipated by contact damping [W].
     pub(crate) dissipation: f64,
@@ -41,6 +49,9 @@ pub(crate) struct Forces {
     /// Friction power [W] (>= 0; part of `dissipation`) per family: pin/disc (or pin/housing
     /// for rolling pins), sun/planet teeth, bearings.
     pub(crate) friction: [f64; 3],
+    /// Net load of the pins on each disc (at most 2): force [N] on the centre (fixed frame) and
+    /// moment [N m] about it, friction and location terms included (for the joint reactions).
+    pub(crate) disc_load: [[f64; 3]; 2],
 }
 
 /// The rigid-joint reducer model: the shared [`Parts`] plus its coordinates.
@@ -48,16 +59,19 @@ pub(crate) struct Forces {
 pub struct RigidModel {
     /// Geometry, laws, inertias, drive and load (shared with the compliant model).
     pub(crate) parts: Parts,
-    /// Diagonal generalised mass of `[th_c, alpha, th_s]`.
-    pub(crate) mass: [f64; 3],
+    /// Diagonal generalised mass of `[th_c, alpha, th_s, th_L, th_m]`.
+    pub(crate) mass: [f64; FULL],
     /// Free coordinates (indices into the full vector).
     pub(crate) free: Vec<usize>,
+    /// Free shaft coordinates (`LOAD`, `MOTOR`; empty without shafts). The adapter's
+    /// coordinates are `free` then these.
+    pub(crate) shaft_free: Vec<usize>,
     /// The prescribed coordinate, if the drive is a speed.
     pub(crate) prescribed: Option<usize>,
     /// The coordinate the drive acts on (sun, or crank without a first stage).
     pub(crate) input: usize,
     /// Lever length per full coordinate [m per rad], turning angle errors into displacements.
-    pub(crate) length_scale: [f64; 3],
+    pub(crate) length_scale: [f64; FULL],
     /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start).
     pub(crate) warm_seeds: Vec<Cell<WarmStart>>,
     /// Skip the exact query of a pin that provably cannot touch (see [`SeparationBound`]).
@@ -90,49 +104,82 @@ impl RigidModel {
         let n_cr = f64::from(scene.cranks);
         let e = cyc.eccentricity;
         let nd = parts.discs.len() as f64;
+        // The load and motor inertias join the carrier and the sun unless a shaft separates
+        // them (docs/model.md#machine-shafts).
+        let (on_carrier, on_sun) = (
+            if parts.output_shaft.is_some() {
+                0.0
+            } else {
+                inertias.load_inertia
+            },
+            if parts.input_shaft.is_some() {
+                0.0
+            } else {
+                inertias.motor_inertia
+            },
+        );
         let mass = [
             inertias.carrier.inertia
-                + inertias.load_inertia
+                + on_carrier
                 + n_cr * inertias.crank.mass * crank_radius * crank_radius
                 + nd * inertias.disc.inertia,
             n_cr * inertias.crank.inertia + nd * inertias.disc.mass * e * e,
-            inertias.sun.inertia,
+            inertias.sun.inertia + on_sun,
+            inertias.load_inertia,
+            inertias.motor_inertia,
         ];
-        let input = if mesh.is_some() { SUN } else { CRANK };
-        let (free, prescribed) = match (parts.drive.is_speed(), mesh.is_some()) {
+        let mut input = if mesh.is_some() { SUN } else { CRANK };
+        let (mut free, mut prescribed) = match (parts.drive.is_speed(), mesh.is_some()) {
             (true, true) => (vec![CARRIER, CRANK], Some(SUN)),
             (false, true) => (vec![CARRIER, CRANK, SUN], None),
             (true, false) => (vec![CARRIER], Some(CRANK)),
             (false, false) => (vec![CARRIER, CRANK], None),
         };
+        let mut shaft_free = Vec::new();
+        if parts.output_shaft.is_some() {
+            shaft_free.push(LOAD);
+        }
+        if parts.input_shaft.is_some() {
+            // The drive acts on the motor; the sun becomes free.
+            if let Some(p) = prescribed {
+                free.push(p);
+                prescribed = Some(MOTOR);
+            } else {
+                shaft_free.push(MOTOR);
+            }
+            input = MOTOR;
+        }
         let rp = cyc.pin_circle_radius;
-        let length_scale = [rp, e, mesh.map_or(0.0, |m| m.sun_base_radius)];
+        let rs = mesh.map_or(0.0, |m| m.sun_base_radius);
+        let length_scale = [rp, e, rs, rp, rs];
+        let skip = parts.discs.iter().all(|d| d.profile_error.is_none());
         Ok(Self {
             parts,
             mass,
             free,
+            shaft_free,
             prescribed,
             input,
             length_scale,
             warm_seeds: vec![Cell::new(WarmStart::default()); scene.discs.len() * zp],
-            skip_separated: true,
+            // The separation bound assumes a rigid profile; a profile error's first-order offset
+            // is not one: query every pin.
+            skip_separated: skip,
             separation: vec![Cell::new(SeparationBound::default()); scene.discs.len() * zp],
         })
     }
 
-    /// Initial full state `(x, v)` at t = 0: kinematic pose, at rest or at kinematic speed.
-    pub(crate) fn initial_state(&self) -> ([f64; 3], [f64; 3]) {
-        let x = [0.0, 0.0, 0.0];
-        let mut v = [0.0; 3];
+    /// Initial full state `(x, v)` at t = 0: kinematic pose, at rest or at kinematic speed
+    /// (shafts untwisted).
+    pub(crate) fn initial_state(&self) -> ([f64; FULL], [f64; FULL]) {
+        let x = [0.0; FULL];
+        let mut v = [0.0; FULL];
         if self.initial == Initial::Steady {
             let w_in = self.drive.full_speed();
             let zc = self.zc();
             let carrier = w_in / self.ratio;
-            v = [
-                carrier,
-                -zc * carrier,
-                if self.mesh.is_some() { w_in } else { 0.0 },
-            ];
+            let sun = if self.mesh.is_some() { w_in } else { 0.0 };
+            v = [carrier, -zc * carrier, sun, carrier, sun];
         }
         if let Some(p) = self.prescribed {
             let (ang, spd, _) = self.drive.motion(0.0);
@@ -147,7 +194,7 @@ impl RigidModel {
     /// Overwrite the prescribed coordinate of a full state with the drive at time `t`;
     /// returns its acceleration.
     #[inline]
-    pub(crate) fn apply_drive(&self, t: f64, x: &mut [f64; 3], v: &mut [f64; 3]) -> f64 {
+    pub(crate) fn apply_drive(&self, t: f64, x: &mut [f64; FULL], v: &mut [f64; FULL]) -> f64 {
         match self.prescribed {
             Some(p) => {
                 let (ang, spd, acc) = self.drive.motion(t);
@@ -206,7 +253,15 @@ impl RigidModel {
                 let n = pc.normal;
                 let lever_c = pc.lever();
                 let lever_a = o[0] * n[1] - o[1] * n[0];
-                let pen_rate = lever_c * vc + lever_a * va;
+                let mut pen_rate = lever_c * vc + lever_a * va;
+                // A profile error's share of the penetration moves with the foot:
+                // d/dth_c = g_theta, d/dalpha = g_O . (z x O).
+                let err_lever = pc
+                    .error_gradient
+                    .map(|(go, gt)| (gt, go[1] * o[0] - go[0] * o[1]));
+                if let Some((ec, ea)) = err_lever {
+                    pen_rate += ec * vc + ea * va;
+                }
                 let site = PinSite {
                     geometry: &d.geometry,
                     phi: pc.phi,
@@ -217,6 +272,19 @@ impl RigidModel {
                 let f = lf.force;
                 out.q[CARRIER] -= f * lever_c;
                 out.q[CRANK] -= f * lever_a;
+                let dl = &mut out.disc_load[k];
+                dl[0] -= f * n[0];
+                dl[1] -= f * n[1];
+                dl[2] -= f * lever_c;
+                if let Some((ec, ea)) = err_lever {
+                    out.q[CARRIER] -= f * ec;
+                    out.q[CRANK] -= f * ea;
+                    let (go, gt) = pc.error_gradient.unwrap_or_default();
+                    let dl = &mut out.disc_load[k];
+                    dl[0] -= f * go[0];
+                    dl[1] -= f * go[1];
+                    dl[2] -= f * gt;
+                }
                 // Sliding friction: the disc's material point at the contact moves at
                 // O' + th' z x arm (O' = alpha' z x O); the force ft t (t = z x n) on the disc
                 // has the virtual work ft (arm . n) on th_c and ft (O . n) on alpha.
@@ -227,6 +295,10 @@ impl RigidModel {
                     let ft = fr.force(vs, f);
                     out.q[CARRIER] += ft * (arm[0] * n[0] + arm[1] * n[1]);
                     out.q[CRANK] += ft * (o[0] * n[0] + o[1] * n[1]);
+                    let dl = &mut out.disc_load[k];
+                    dl[0] -= ft * n[1];
+                    dl[1] += ft * n[0];
+                    dl[2] += ft * (arm[0] * n[0] + arm[1] * n[1]);
                     let p = -ft * vs;
                     out.dissipation += p;
                     out.friction[0] += p;
@@ -240,6 +312,10 @@ impl RigidModel {
                     let (fo, m) = ls.forces();
                     out.q[CARRIER] += m;
                     out.q[CRANK] += fo[1] * o[0] - fo[0] * o[1];
+                    let dl = &mut out.disc_load[k];
+                    dl[0] += fo[0];
+                    dl[1] += fo[1];
+                    dl[2] += m;
                 }
                 out.dissipation += (f - lf.elastic) * pen_rate;
                 out.potential += lf.energy;
@@ -265,50 +341,82 @@ impl RigidModel {
                 (0.0, 0.0, 0.0)
             };
             for i in 0..m.count {
-                let mut f = 0.0;
-                if pen > 0.0 {
-                    if check && (pen.is_nan() || pen >= self.max_penetration) {
-                        return Err(penetration_error(
-                            t,
-                            pen,
-                            self.max_penetration,
-                            "a sun/planet mesh",
-                        ));
+                let mut f_report = 0.0;
+                let mut delta_report = delta;
+                // Without gear errors one flank at most, shared by all planets; with errors
+                // each flank of each planet has its own extra approach (runout, pitch).
+                let mut flanks = [(pen, pen_rate, sign, MeshOffset::default()); 2];
+                let nf = match &self.mesh_errors {
+                    None => 1,
+                    Some(me) => {
+                        for (slot, sg) in flanks.iter_mut().zip([1.0, -1.0]) {
+                            let off = me.offset(i, sg, x[CARRIER], x[SUN], x[CRANK]);
+                            *slot = (
+                                sg * delta + off.value - half,
+                                sg * rate + off.rate(vc, v[SUN], va),
+                                sg,
+                                off,
+                            );
+                            if sg > 0.0 {
+                                delta_report = delta + off.value;
+                            }
+                        }
+                        2
                     }
-                    // The coast flank (sign -1) runs through its tooth pairs in the mirrored
-                    // order: its mesh position is -s.
-                    let s_flank = sign * (s0 + m.phases[i] * m.base_pitch);
-                    let (lf, dk) = m.law.evaluate(pen, pen_rate, s_flank, want_energy);
-                    f = sign * lf.force;
-                    out.q[CARRIER] += f * (m.sun_base_radius + m.planet_base_radius);
-                    out.q[CRANK] -= f * m.planet_base_radius;
-                    out.q[SUN] -= f * m.sun_base_radius;
-                    // A stiffness that varies with the mesh position s stores
-                    // V = k(s) pen^2 / 2; its s-derivative is a generalised force too
-                    // (ds/dth_s = r_bs, ds/dth_c = -r_bs), which keeps the energy balance
-                    // (Oh, Grosh & Barber 2005).
-                    let dv_ds = 0.5 * dk * pen * pen * sign;
-                    out.q[SUN] -= dv_ds * m.sun_base_radius;
-                    out.q[CARRIER] += dv_ds * m.sun_base_radius;
-                    out.dissipation += (lf.force - lf.elastic) * pen_rate;
-                    out.potential += lf.energy;
-                    // Tooth friction (mirrored on the coast flank like the mesh position).
-                    if let Some(fr) = &self.mesh_friction {
-                        let w1 = sign * (v[SUN] - vc);
-                        let w2 = sign * (va - vc);
-                        let (t1, t2, p) = m.path.torques(fr, lf.force, s_flank, w1, w2);
-                        out.q[SUN] += sign * t1;
-                        out.q[CRANK] += sign * t2;
-                        out.q[CARRIER] -= sign * (t1 + t2);
-                        out.dissipation += p;
-                        out.friction[1] += p;
+                };
+                for &(pen, pen_rate, sign, off) in &flanks[..nf] {
+                    let mut f = 0.0;
+                    if pen > 0.0 {
+                        if check && (pen.is_nan() || pen >= self.max_penetration) {
+                            return Err(penetration_error(
+                                t,
+                                pen,
+                                self.max_penetration,
+                                "a sun/planet mesh",
+                            ));
+                        }
+                        // The coast flank (sign -1) runs through its tooth pairs in the mirrored
+                        // order: its mesh position is -s.
+                        let s_flank = sign * (s0 + m.phases[i] * m.base_pitch);
+                        let (lf, dk) = m.law.evaluate(pen, pen_rate, s_flank, want_energy);
+                        f = sign * lf.force;
+                        out.q[CARRIER] += f * (m.sun_base_radius + m.planet_base_radius);
+                        out.q[CRANK] -= f * m.planet_base_radius;
+                        out.q[SUN] -= f * m.sun_base_radius;
+                        // Gear errors: -F grad(E) (zero without them).
+                        if self.mesh_errors.is_some() {
+                            out.q[CARRIER] -= lf.force * off.carrier;
+                            out.q[SUN] -= lf.force * off.sun;
+                            out.q[CRANK] -= lf.force * off.crank;
+                        }
+                        // A stiffness that varies with the mesh position s stores
+                        // V = k(s) pen^2 / 2; its s-derivative is a generalised force too
+                        // (ds/dth_s = r_bs, ds/dth_c = -r_bs), which keeps the energy balance
+                        // (Oh, Grosh & Barber 2005).
+                        let dv_ds = 0.5 * dk * pen * pen * sign;
+                        out.q[SUN] -= dv_ds * m.sun_base_radius;
+                        out.q[CARRIER] += dv_ds * m.sun_base_radius;
+                        out.dissipation += (lf.force - lf.elastic) * pen_rate;
+                        out.potential += lf.energy;
+                        // Tooth friction (mirrored on the coast flank like the mesh position).
+                        if let Some(fr) = &self.mesh_friction {
+                            let w1 = sign * (v[SUN] - vc);
+                            let w2 = sign * (va - vc);
+                            let (t1, t2, p) = m.path.torques(fr, lf.force, s_flank, w1, w2);
+                            out.q[SUN] += sign * t1;
+                            out.q[CRANK] += sign * t2;
+                            out.q[CARRIER] -= sign * (t1 + t2);
+                            out.dissipation += p;
+                            out.friction[1] += p;
+                        }
                     }
+                    f_report += f;
                 }
-                sink.mesh(i, f, delta);
+                sink.mesh(i, f_report, delta_report);
             }
         }
-        out.q[CARRIER] -= self.load.torque(t);
-        if let Some(tq) = self.drive.torque(t) {
+        out.q[CARRIER] -= self.carrier_load(t);
+        if let Some(tq) = self.input_drive_torque(t) {
             out.q[self.input] += tq;
         }
         if !out.q.iter().all(|v| v.is_finite()) {
@@ -320,10 +428,53 @@ impl RigidModel {
         Ok(out)
     }
 
+    /// Reactions of the ideal eccentric bearings on the discs [N], at `i * discs + k` (crank
+    /// `i`, disc `k`; fixed frame), from each disc's balance with the pins at the state
+    /// `(x, v)` with accelerations `a` (docs/model.md#bearing-reactions-of-ideal-joints): the net
+    /// reaction `R = m_d O'' - F_pins` and moment `M = J_d theta'' - M_pins` split over the
+    /// cranks as equal isotropic bearings share them, `R_i = R / n + M (z x h_i) / sum |h|^2`
+    /// (`h_i` the hole centres from the disc centre; the split of a redundant support is not
+    /// given by the rigid constraints alone).
+    pub(crate) fn eccentric_reactions(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        a: &[f64],
+        f: &Forces,
+    ) -> Vec<[f64; 2]> {
+        let n = self.cranks;
+        let nd = self.discs.len();
+        let md = self.inertias.disc;
+        let e = self.eccentricity;
+        let mut out = vec![[0.0; 2]; n * nd];
+        let h2 = n as f64 * self.crank_radius * self.crank_radius;
+        for (k, d) in self.discs.iter().enumerate() {
+            let (sb, cb) = (x[CRANK] + d.phase).sin_cos();
+            let (w, dw) = (v[CRANK], a[CRANK]);
+            let acc = [e * (-sb * dw - cb * w * w), e * (cb * dw - sb * w * w)];
+            let dl = f.disc_load[k];
+            let r = [md.mass * acc[0] - dl[0], md.mass * acc[1] - dl[1]];
+            let mr = md.inertia * a[CARRIER] - dl[2];
+            for i in 0..n {
+                let g = std::f64::consts::TAU * i as f64 / n as f64 + x[CARRIER];
+                let (sg, cg) = g.sin_cos();
+                // z x h_i / sum |h|^2, h_i = r_cr (cos g, sin g).
+                let t = [-sg * self.crank_radius / h2, cg * self.crank_radius / h2];
+                out[i * nd + k] = [r[0] / n as f64 + mr * t[0], r[1] / n as f64 + mr * t[1]];
+            }
+        }
+        out
+    }
+
     /// Kinetic energy of the free bodies [J] (the prescribed input is a driver, not counted).
-    pub(crate) fn kinetic_energy(&self, v: &[f64; 3]) -> f64 {
-        (0..3)
-            .filter(|i| Some(*i) != self.prescribed && (*i != SUN || self.mesh.is_some()))
+    pub(crate) fn kinetic_energy(&self, v: &[f64; FULL]) -> f64 {
+        (0..FULL)
+            .filter(|i| {
+                Some(*i) != self.prescribed
+                    && (*i != SUN || self.mesh.is_some())
+                    && (*i != LOAD || self.output_shaft.is_some())
+                    && (*i != MOTOR || self.input_shaft.is_some())
+            })
             .map(|i| 0.5 * self.mass[i] * v[i] * v[i])
             .sum()
     }
@@ -360,7 +511,9 @@ mod tests {
         for step in 0..300 {
             ga.step(&sys, &mut st, 1e-4).unwrap();
             for wobble in [0.0, 3e-6, -2e-5] {
-                let (mut x, xv, _) = sys.full(st.t, &st.q, &st.v);
+                let (x5, xv5, _) = sys.full(st.t, &st.q, &st.v);
+                let mut x = [x5[0], x5[1], x5[2]];
+                let xv = [xv5[0], xv5[1], xv5[2]];
                 x[CARRIER] += wobble * ((step % 7) as f64 - 3.0);
                 let a = skipping.forces(st.t, &x, &xv, &mut NoSink).unwrap();
                 let b = fresh.forces(st.t, &x, &xv, &mut NoSink).unwrap();

@@ -234,12 +234,12 @@ pub fn simulate(scene: &Scene, options: &SimOptions, control: &RunControl) -> Re
     match scene.joints {
         Joints::Rigid => {
             let mut model = RigidModel::new(scene)?;
-            model.skip_separated = options.skip_separated;
+            model.skip_separated &= options.skip_separated;
             checked_run(scene, &RigidSystem::new(&model), options, control)
         }
         Joints::Compliant { .. } => {
             let mut model = crate::dynamics::model::compliant::CompliantModel::new(scene)?;
-            model.skip_separated = options.skip_separated;
+            model.skip_separated &= options.skip_separated;
             checked_run(scene, &model, options, control)
         }
     }

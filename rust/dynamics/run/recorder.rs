@@ -209,6 +209,34 @@ pub static CHANNELS: &[ChannelSpec] = &[
         "disc rotation angles",
     ),
     spec(
+        "load_angle",
+        Some(Motion),
+        &[],
+        "rad",
+        "load angle (the carrier's without an output shaft)",
+    ),
+    spec(
+        "load_speed",
+        Some(Motion),
+        &[],
+        "rad/s",
+        "load speed (the carrier's without an output shaft)",
+    ),
+    spec(
+        "motor_angle",
+        Some(Motion),
+        &[],
+        "rad",
+        "motor angle (the input's without a drive shaft)",
+    ),
+    spec(
+        "motor_speed",
+        Some(Motion),
+        &[],
+        "rad/s",
+        "motor speed (the input's without a drive shaft)",
+    ),
+    spec(
         "pin_force",
         Some(Pins),
         &[Dim::Discs, Dim::Pins],
@@ -272,6 +300,20 @@ pub static CHANNELS: &[ChannelSpec] = &[
         &[],
         "N m",
         "torque the drive applies to the input",
+    ),
+    spec(
+        "output_shaft_torque",
+        Some(Mesh),
+        &[],
+        "N m",
+        "torque in the output shaft (the load torque without one)",
+    ),
+    spec(
+        "input_shaft_torque",
+        Some(Mesh),
+        &[],
+        "N m",
+        "torque in the drive shaft (the input torque without one)",
     ),
     spec(
         "kinetic_energy",
@@ -349,7 +391,8 @@ pub static CHANNELS: &[ChannelSpec] = &[
         Some(Bearings),
         &[Dim::Cranks, Dim::Discs, Dim::Xy],
         "N",
-        "force of the eccentric bearing of crank i on disc k, fixed frame (0 with ideal joints)",
+        "force of the eccentric bearing of crank i on disc k, fixed frame (ideal joints: the \
+         reactions from each disc's balance, split as equal bearings share them)",
     ),
 ];
 
@@ -563,6 +606,10 @@ impl Recorder {
                 self.push("disc_center", &obs.disc_center[k]);
             }
             self.push("disc_angle", &obs.disc_angle);
+            self.push("load_angle", &[obs.load_angle]);
+            self.push("load_speed", &[obs.load_speed]);
+            self.push("motor_angle", &[obs.motor_angle]);
+            self.push("motor_speed", &[obs.motor_speed]);
         }
         if has(Channel::Pins) {
             let zp = self.sink.zp;
@@ -597,6 +644,8 @@ impl Recorder {
             self.push("mesh_force", &mf);
             self.push("mesh_deflection", &md);
             self.push("input_torque", &[obs.input_torque]);
+            self.push("output_shaft_torque", &[obs.output_shaft_torque]);
+            self.push("input_shaft_torque", &[obs.input_shaft_torque]);
         }
         if has(Channel::Energy) {
             let e = obs.kinetic_energy + obs.potential_energy;

@@ -17,7 +17,7 @@ pub use presets::{
 
 use crate::contact::ImpactLaw;
 use crate::contact::law::{ContactDamping, DampingSpec, IsoMesh, MeshLaw, PinLaw, scene_material};
-use crate::error::{Result, RvdynError};
+use crate::error::{Result, RvdynError, num};
 use crate::geometry::cycloid::CycloidParams;
 use crate::geometry::involute::InvoluteStage;
 use crate::geometry::mass::MassProperties;
@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// One cycloid disc on the crank eccentrics.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DiscSpec {
     /// Phase of this disc's eccentric on the crank [rad] (0 and pi for the two-disc RV).
@@ -39,6 +39,135 @@ pub struct DiscSpec {
     /// Rotation modification of this disc [rad] (`None` = the scene's).
     #[serde(default)]
     pub d_delta: Option<f64>,
+    /// Profile error of this disc: a normal offset of the ground profile (`None` = none;
+    /// docs/model.md#manufacturing-errors-of-profile-and-gears).
+    #[serde(default)]
+    pub profile_error: Option<ProfileError>,
+}
+
+pub use crate::geometry::cycloid::ProfileError;
+
+/// A torsional shaft between two inertias (SI).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Shaft {
+    /// Torsional stiffness [N m/rad] (> 0).
+    pub stiffness: f64,
+    /// Torsional damping [N m s/rad] (>= 0; default 0).
+    #[serde(default)]
+    pub damping: f64,
+}
+
+/// The shafts that connect the reducer to its machine: `None` = rigid connection (the load
+/// inertia joins the carrier, the motor inertia the sun).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Shafts {
+    /// Output shaft between the carrier and the load inertia (`inertias.load_inertia`, which
+    /// must then be > 0); the load torque acts on the load inertia.
+    #[serde(default)]
+    pub output: Option<Shaft>,
+    /// Drive shaft (coupling) between the motor (`inertias.motor_inertia`) and the sun; the
+    /// drive then acts on the motor. Needs a first stage.
+    #[serde(default)]
+    pub input: Option<Shaft>,
+}
+
+/// Runout and pitch error of one gear of the first stage (SI; zero = a perfect gear).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GearError {
+    /// Runout: eccentricity of the gear's toothing on its axis [m] (>= 0).
+    #[serde(default)]
+    pub runout: f64,
+    /// Direction of the runout in the gear's body frame [rad].
+    #[serde(default)]
+    pub runout_phase: f64,
+    /// Amplitude of a sinusoidal cumulative pitch deviation at the rotation order [m, on the
+    /// reference circle]: `F(psi) = A sin(psi + pitch_phase)`, `psi` the body angle of the tooth.
+    #[serde(default)]
+    pub pitch_amplitude: f64,
+    /// Phase of the sinusoidal pitch deviation [rad].
+    #[serde(default)]
+    pub pitch_phase: f64,
+    /// Cumulative pitch deviation of each tooth [m, on the reference circle] (empty, or one
+    /// per tooth; tooth k at body angle `2 pi k / z`, linear in between, periodic; positive =
+    /// the tooth is ahead in the positive sense of rotation).
+    #[serde(default)]
+    pub pitch_deviation: Vec<f64>,
+}
+
+impl GearError {
+    /// Whether this gear has any error.
+    pub fn any(&self) -> bool {
+        self.runout != 0.0 || self.pitch_amplitude != 0.0 || !self.pitch_deviation.is_empty()
+    }
+
+    /// Check the fields (`at` names the gear, e.g. `"gear_errors.sun"`): finite, runout >= 0,
+    /// every deviation below `limit` [m] in magnitude, `teeth` deviations or none.
+    pub fn check(&self, at: &str, teeth: u32, limit: f64) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Scene(format!("{at}.{m}")));
+        for (n, v) in [
+            ("runout_phase", self.runout_phase),
+            ("pitch_phase", self.pitch_phase),
+        ] {
+            if !v.is_finite() {
+                return bad(format!("{n} must be finite rad, got {v}"));
+            }
+        }
+        if !(self.runout.is_finite() && self.runout >= 0.0 && self.runout < limit) {
+            return bad(format!(
+                "runout must be in [0, {}) m (a tenth of the module), got {}",
+                num(limit),
+                self.runout
+            ));
+        }
+        if !(self.pitch_amplitude.is_finite() && self.pitch_amplitude.abs() < limit) {
+            return bad(format!(
+                "pitch_amplitude must be finite and smaller than {} m (a tenth of the \
+                 module) in magnitude, got {}",
+                num(limit),
+                self.pitch_amplitude
+            ));
+        }
+        let n = self.pitch_deviation.len();
+        if n != 0 && n != teeth as usize {
+            return bad(format!(
+                "pitch_deviation must be empty or have one value per tooth ({teeth}), got {n}"
+            ));
+        }
+        if let Some(v) = self
+            .pitch_deviation
+            .iter()
+            .find(|v| !(v.is_finite() && v.abs() < limit))
+        {
+            return bad(format!(
+                "pitch_deviation values must be finite and smaller than {} m (a tenth of \
+                 the module) in magnitude, got {v}",
+                num(limit)
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Runout and pitch errors of the first-stage gears (docs/model.md#manufacturing-errors-of-profile-and-gears).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GearErrors {
+    /// The sun.
+    #[serde(default)]
+    pub sun: GearError,
+    /// Each planet (empty = none, or one per planet).
+    #[serde(default)]
+    pub planets: Vec<GearError>,
+}
+
+impl GearErrors {
+    /// Whether any gear has an error.
+    pub fn any(&self) -> bool {
+        self.sun.any() || self.planets.iter().any(GearError::any)
+    }
 }
 
 /// Pin manufacturing errors (optional, per pin; index j is the paper's pin j+1).
@@ -134,9 +263,14 @@ pub struct Inertias {
     /// Carrier (output) with everything bolted to it (inertia about the reducer axis).
     #[serde(default)]
     pub carrier: Option<MassProperties>,
-    /// Extra load inertia on the output [kg m^2].
+    /// Extra load inertia on the output [kg m^2] (on the carrier, or at the end of the output
+    /// shaft when `shafts.output` is given).
     #[serde(default)]
     pub load_inertia: f64,
+    /// Motor (rotor) inertia on the input [kg m^2] (on the sun, or at the end of the drive
+    /// shaft when `shafts.input` is given; needs a first stage when > 0).
+    #[serde(default)]
+    pub motor_inertia: f64,
 }
 
 /// A bearing spring-damper (compliant joints): linear (`stiffness`, `damping`), or built from
@@ -654,6 +788,12 @@ pub struct Scene {
     /// Manufacturing and assembly errors of cranks, discs and carrier (default: none).
     #[serde(default)]
     pub errors: AssemblyErrors,
+    /// Runout and pitch errors of the first-stage gears (default: none).
+    #[serde(default)]
+    pub gear_errors: GearErrors,
+    /// Output and drive shafts (default: rigid connections).
+    #[serde(default)]
+    pub shafts: Shafts,
     /// The input drive.
     pub drive: Drive,
     /// The load on the output.

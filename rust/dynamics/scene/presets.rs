@@ -121,12 +121,14 @@ impl Scene {
                     d_rp: None,
                     d_rrp: None,
                     d_delta: None,
+                    profile_error: None,
                 },
                 DiscSpec {
                     phase: PI,
                     d_rp: None,
                     d_rrp: None,
                     d_delta: None,
+                    profile_error: None,
                 },
             ],
             cranks: 3,
@@ -136,6 +138,8 @@ impl Scene {
             joints: Joints::Rigid,
             friction: Friction::default(),
             errors: AssemblyErrors::default(),
+            gear_errors: GearErrors::default(),
+            shafts: Shafts::default(),
             contact: ContactLaws {
                 pin: ContactLawSpec::paper(),
                 mesh: ContactLawSpec::paper(),

@@ -27,6 +27,13 @@ impl Scene {
                 }
             }
             crate::geometry::CycloidGeometry::check(self.disc_params(k))?;
+            if let Some(pe) = &d.profile_error {
+                pe.check(
+                    &format!("discs[{k}].profile_error"),
+                    crate::geometry::cycloid::ProfileError::LIMIT_FRACTION
+                        * self.cycloid.pin_radius,
+                )?;
+            }
         }
         crate::geometry::involute::check_crank_count(self.cranks)?;
         if let Some(s) = &self.stage1 {
@@ -92,6 +99,7 @@ impl Scene {
                 i.load_inertia
             ));
         }
+        self.validate_drive_train()?;
         if let Joints::Compliant {
             eccentric_bearing,
             crank_bearing,
@@ -231,6 +239,78 @@ impl Scene {
                 if points.windows(2).any(|w| w[1][0] <= w[0][0]) {
                     return err("load.points times must increase strictly".into());
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// Shafts, motor inertia and gear errors (docs/scene.md: `shafts`, `gear_errors`).
+    fn validate_drive_train(&self) -> Result<()> {
+        let err = |m: String| Err(RvdynError::Scene(m));
+        let jm = self.inertias.motor_inertia;
+        if !(jm.is_finite() && jm >= 0.0) {
+            return err(format!(
+                "inertias.motor_inertia must be >= 0 kg m^2, got {jm}"
+            ));
+        }
+        if jm > 0.0 && self.stage1.is_none() {
+            return err(
+                "inertias.motor_inertia > 0 needs a first stage (stage1): the motor drives the \
+                 sun"
+                .into(),
+            );
+        }
+        for (n, sh) in [("output", self.shafts.output), ("input", self.shafts.input)] {
+            let Some(sh) = sh else { continue };
+            if !(sh.stiffness.is_finite() && sh.stiffness > 0.0) {
+                return err(format!(
+                    "shafts.{n}.stiffness must be > 0 N m/rad (omit the shaft for a rigid \
+                     connection), got {}",
+                    sh.stiffness
+                ));
+            }
+            if !(sh.damping.is_finite() && sh.damping >= 0.0) {
+                return err(format!(
+                    "shafts.{n}.damping must be >= 0 N m s/rad, got {}",
+                    sh.damping
+                ));
+            }
+        }
+        if self.shafts.output.is_some() && self.inertias.load_inertia <= 0.0 {
+            return err(
+                "shafts.output needs inertias.load_inertia > 0 kg m^2 (the inertia at the \
+                 shaft's far end)"
+                    .into(),
+            );
+        }
+        if self.shafts.input.is_some() {
+            if self.stage1.is_none() {
+                return err("shafts.input needs a first stage (stage1): it drives the sun".into());
+            }
+            if matches!(self.drive, Drive::Torque { .. }) && jm <= 0.0 {
+                return err(
+                    "shafts.input with a torque drive needs inertias.motor_inertia > 0 kg m^2 \
+                     (the motor the torque acts on)"
+                        .into(),
+                );
+            }
+        }
+        let g = &self.gear_errors;
+        if g.any() || !g.planets.is_empty() {
+            let Some(s) = &self.stage1 else {
+                return err("gear_errors need a first stage (stage1)".into());
+            };
+            let limit = 0.1 * s.module;
+            g.sun.check("gear_errors.sun", s.z_sun, limit)?;
+            if !g.planets.is_empty() && g.planets.len() != s.planets as usize {
+                return err(format!(
+                    "gear_errors.planets must be empty or have one entry per planet ({}), got {}",
+                    s.planets,
+                    g.planets.len()
+                ));
+            }
+            for (i, p) in g.planets.iter().enumerate() {
+                p.check(&format!("gear_errors.planets[{i}]"), s.z_planet, limit)?;
             }
         }
         Ok(())

@@ -109,9 +109,21 @@ impl CompliantModel {
                 let w_drive = [sp * u[0] + cp * zu[0], sp * u[1] + cp * zu[1]];
                 let w_coast = [sp * u[0] - cp * zu[0], sp * u[1] - cp * zu[1]];
                 let mut f_report = 0.0;
+                let mut e_drive = 0.0;
                 for (sign, w) in [(1.0, w_drive), (-1.0, w_coast)] {
                     let zw = perp(w);
-                    let pen = sign * rot - dot(d, w) - half;
+                    let mut pen = sign * rot - dot(d, w) - half;
+                    // Gear errors (runout, pitch): an extra approach E(th_c, th_s, alpha_i).
+                    let off = m
+                        .mesh_errors
+                        .as_ref()
+                        .map(|me| me.offset(i, sign, thc, x[SUN], alpha));
+                    if let Some(off) = &off {
+                        pen += off.value;
+                        if sign > 0.0 {
+                            e_drive = off.value;
+                        }
+                    }
                     if pen <= 0.0 {
                         continue;
                     }
@@ -123,7 +135,10 @@ impl CompliantModel {
                             &format!("sun/planet mesh {i}"),
                         ));
                     }
-                    let rate = sign * rot_rate - dot(dd, w) - vc * dot(d, zw);
+                    let mut rate = sign * rot_rate - dot(dd, w) - vc * dot(d, zw);
+                    if let Some(off) = &off {
+                        rate += off.rate(vc, v[SUN], va);
+                    }
                     // The coast flank runs through its tooth pairs in the mirrored order:
                     // its mesh position is -s (a reversed run mirrors a forward one).
                     let (lf, dk) = mm.law.evaluate(pen, rate, sign * s_mesh, want_energy);
@@ -135,6 +150,11 @@ impl CompliantModel {
                     qf[ci] += f * w[0];
                     qf[ci + 1] += f * w[1];
                     qf[CARRIER] += f * (sign * (rbs + rbp) - dot(perp(s), w) + dot(d, zw));
+                    if let Some(off) = &off {
+                        qf[CARRIER] -= f * off.carrier;
+                        qf[SUN] -= f * off.sun;
+                        qf[ci + 2] -= f * off.crank;
+                    }
                     // Position-dependent stiffness: dV/ds with ds/dth_s = r_bs,
                     // ds/dth_c = -r_bs (Oh, Grosh & Barber 2005).
                     let dv_ds = 0.5 * dk * pen * pen * sign;
@@ -156,7 +176,7 @@ impl CompliantModel {
                     }
                     f_report += sign * f;
                 }
-                sink.mesh(i, f_report, rot - dot(d, w_drive));
+                sink.mesh(i, f_report, rot - dot(d, w_drive) + e_drive);
             }
         }
         for (k, disc) in m.discs.iter().enumerate() {
@@ -179,7 +199,7 @@ impl CompliantModel {
                 let pen = pc.penetration;
                 let n = pc.normal;
                 let lever = pc.lever();
-                let pen_rate = dot(n, ov) + vt * lever;
+                let pen_rate = dot(n, ov) + vt * lever + pc.error_rate(ov, vt);
                 let site = PinSite {
                     geometry: &disc.geometry,
                     phi: pc.phi,
@@ -191,6 +211,12 @@ impl CompliantModel {
                 qf[dk] -= f * n[0];
                 qf[dk + 1] -= f * n[1];
                 qf[dk + 2] -= f * lever;
+                // A profile error's share of the penetration moves with the foot.
+                if let Some((go, gt)) = pc.error_gradient {
+                    qf[dk] -= f * go[0];
+                    qf[dk + 1] -= f * go[1];
+                    qf[dk + 2] -= f * gt;
+                }
                 // Sliding friction (see the rigid model): material point velocity
                 // O' + th' z x arm, force ft t on the disc, t = z x n.
                 if let Some(fr) = &m.pin_friction {
@@ -232,12 +258,21 @@ impl CompliantModel {
                 qf[ci + 1] = 0.0;
             }
         }
-        qf[CARRIER] -= m.load.torque(t);
-        if let Some(tq) = m.drive.torque(t) {
+        qf[CARRIER] -= m.carrier_load(t);
+        if let Some(tq) = m.input_drive_torque(t) {
             let share = tq / self.input.len() as f64;
             for &i in &self.input {
                 qf[i] += share;
             }
+        }
+        if self.load_index.is_some() || self.motor_index.is_some() {
+            let (sh, li, mi) = self.shafts(t, x, v);
+            qf[CARRIER] += sh.carrier;
+            qf[SUN] += sh.input;
+            qf[li] += sh.load;
+            qf[mi] += sh.motor;
+            out.dissipation += sh.dissipation;
+            out.potential += sh.potential;
         }
         if !qf.iter().all(|v| v.is_finite()) {
             return Err(RvdynError::Simulation(format!(

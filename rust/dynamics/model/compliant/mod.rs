@@ -86,7 +86,7 @@ pub(crate) struct Flows {
     /// Power dissipated by contact and bearing damping and by friction [W].
     dissipation: f64,
     /// Elastic energy of the contacts and bearings [J] (contacts only when asked for).
-    potential: f64,
+    pub(crate) potential: f64,
     /// Friction power per family [W]: pins, teeth, bearings (part of `dissipation`).
     friction: [f64; 3],
 }
@@ -111,8 +111,11 @@ pub struct CompliantModel {
     pressure: [f64; 2],
     /// Diagonal mass of every full coordinate [kg or kg m^2].
     pub(crate) mass: Vec<f64>,
-    /// Free coordinates (indices into the full vector).
+    /// Free coordinates of the reducer (indices into the full vector; what the quasi-static
+    /// and modal analyses see).
     pub(crate) free: Vec<usize>,
+    /// All free coordinates: `free`, then the machine shafts' (load, motor).
+    pub(crate) coords: Vec<usize>,
     /// Prescribed coordinates (the sun, or every crank rotation without a first stage).
     pub(crate) prescribed: Vec<usize>,
     /// Coordinates the input torque acts on (shared equally).
@@ -133,6 +136,10 @@ pub struct CompliantModel {
     /// Palmgren friction of the eccentric and crank bearings, with the regularisation speeds
     /// [rad/s] of their relative rotation.
     bearing_friction: Option<[(PalmgrenFriction, f64); 2]>,
+    /// Index of the load angle in the full vector (with an output shaft).
+    pub(crate) load_index: Option<usize>,
+    /// Index of the motor angle in the full vector (with a drive shaft).
+    pub(crate) motor_index: Option<usize>,
 }
 
 impl CompliantModel {
@@ -212,7 +219,6 @@ impl CompliantModel {
         let e = base.eccentricity;
         let rp = scene.cycloid.pin_circle_radius;
         let crank_lever = base.mesh.map_or(e, |m| m.planet_base_radius.max(e));
-        let n_full = 2 + 3 * n + 3 * nd;
         let zp = base.pins.len();
         let rigid_cranks = crank_bearing.is_none();
         let crank_orbit = if rigid_cranks {
@@ -220,9 +226,21 @@ impl CompliantModel {
         } else {
             0.0
         };
+        // The load and motor inertias join the carrier and the sun unless a shaft separates
+        // them (docs/model.md#machine-shafts).
+        let on_carrier = if base.output_shaft.is_some() {
+            0.0
+        } else {
+            inr.load_inertia
+        };
+        let on_sun = if base.input_shaft.is_some() {
+            0.0
+        } else {
+            inr.motor_inertia
+        };
         let mut mass = vec![
-            inr.carrier.inertia + inr.load_inertia + crank_orbit,
-            inr.sun.inertia,
+            inr.carrier.inertia + on_carrier + crank_orbit,
+            inr.sun.inertia + on_sun,
         ];
         let mut lever = vec![rp, base.mesh.map_or(0.0, |m| m.sun_base_radius)];
         for _ in 0..n {
@@ -233,26 +251,46 @@ impl CompliantModel {
             mass.extend([inr.disc.mass, inr.disc.mass, inr.disc.inertia]);
             lever.extend([1.0, 1.0, rp]);
         }
+        let mut load_index = None;
+        if base.output_shaft.is_some() {
+            load_index = Some(mass.len());
+            mass.push(inr.load_inertia);
+            lever.push(rp);
+        }
+        let mut motor_index = None;
+        if base.input_shaft.is_some() {
+            motor_index = Some(mass.len());
+            mass.push(inr.motor_inertia);
+            lever.push(lever[SUN]);
+        }
+        let n_full = mass.len();
         let crank_rotations: Vec<usize> = (0..n).map(|i| crank_index(i) + 2).collect();
         let has_mesh = base.mesh.is_some();
-        let input = if has_mesh {
-            vec![SUN]
-        } else {
-            crank_rotations.clone()
+        let input = match motor_index {
+            Some(mi) => vec![mi],
+            None if has_mesh => vec![SUN],
+            None => crank_rotations.clone(),
         };
-        let prescribed = match (base.drive.is_speed(), has_mesh) {
-            (true, true) => vec![SUN],
-            (true, false) => crank_rotations,
-            (false, _) => Vec::new(),
+        let prescribed = match (base.drive.is_speed(), has_mesh, motor_index) {
+            (true, _, Some(mi)) => vec![mi],
+            (true, true, None) => vec![SUN],
+            (true, false, None) => crank_rotations,
+            (false, _, _) => Vec::new(),
         };
         let crank_centres: Vec<usize> = (0..n)
             .flat_map(|i| [crank_index(i), crank_index(i) + 1])
             .collect();
-        let free: Vec<usize> = (0..n_full)
+        let coords: Vec<usize> = (0..n_full)
             .filter(|i| !prescribed.contains(i) && (*i != SUN || has_mesh))
             .filter(|i| !(rigid_cranks && crank_centres.contains(i)))
             .collect();
-        let scale = free.iter().map(|&i| lever[i]).collect();
+        let free: Vec<usize> = coords
+            .iter()
+            .copied()
+            .filter(|i| Some(*i) != load_index && Some(*i) != motor_index)
+            .collect();
+        let scale = coords.iter().map(|&i| lever[i]).collect();
+        let base_skip = base.discs.iter().all(|d| d.profile_error.is_none());
         Ok(Self {
             parts: base,
             eccentric_bearing: BearingLaw::new(&eccentric_bearing)?,
@@ -263,16 +301,21 @@ impl CompliantModel {
             pressure,
             mass,
             free,
+            coords,
             prescribed,
             input,
             scale,
             warm_seeds: vec![Cell::new(WarmStart::default()); nd * zp],
-            skip_separated: true,
+            // The separation bound assumes a rigid profile; a profile error's first-order
+            // offset is not one: query every pin.
+            skip_separated: base_skip,
             separation: vec![Cell::new(SeparationBound::default()); nd * zp],
             seat_vecs,
             ecc_radius,
             ecc_phase,
             bearing_friction,
+            load_index,
+            motor_index,
         })
     }
 
@@ -325,6 +368,12 @@ impl CompliantModel {
             x[dk..dk + 3].copy_from_slice(&[o[0], o[1], d.angle_offset]);
             v[dk..dk + 3].copy_from_slice(&[ov[0], ov[1], wc]);
         }
+        if let Some(li) = self.load_index {
+            v[li] = v[CARRIER];
+        }
+        if let Some(mi) = self.motor_index {
+            v[mi] = v[SUN];
+        }
         self.apply_drive(0.0, &mut x, &mut v);
         (x, v)
     }
@@ -364,7 +413,7 @@ impl CompliantModel {
         let n_full = self.full_len();
         let mut x = vec![0.0; n_full];
         let mut xv = vec![0.0; n_full];
-        for (k, &i) in self.free.iter().enumerate() {
+        for (k, &i) in self.coords.iter().enumerate() {
             x[i] = q[k];
             xv[i] = v[k];
         }
@@ -398,9 +447,37 @@ impl CompliantModel {
         (crank, ecc)
     }
 
+    /// The shafts' loads at `(t, x, v)` (full coordinates) with the load and motor indices
+    /// (the carrier's and the input's without shafts).
+    pub(crate) fn shafts(
+        &self,
+        t: f64,
+        x: &[f64],
+        v: &[f64],
+    ) -> (crate::dynamics::model::parts::ShaftLoads, usize, usize) {
+        let li = self.load_index.unwrap_or(CARRIER);
+        let mi = self.motor_index.unwrap_or(if self.parts.mesh.is_some() {
+            SUN
+        } else {
+            crank_index(0) + 2
+        });
+        let sh = if self.load_index.is_some() || self.motor_index.is_some() {
+            self.parts.shaft_loads(
+                t,
+                [x[CARRIER], v[CARRIER]],
+                [x[SUN], v[SUN]],
+                [x[li], v[li]],
+                [x[mi], v[mi]],
+            )
+        } else {
+            Default::default()
+        };
+        (sh, li, mi)
+    }
+
     /// Kinetic energy of the free bodies [J] (a prescribed input is a driver, not counted).
     fn kinetic_energy(&self, v: &[f64]) -> f64 {
-        self.free
+        self.coords
             .iter()
             .map(|&i| 0.5 * self.mass[i] * v[i] * v[i])
             .sum()
@@ -415,7 +492,7 @@ fn crank_index(i: usize) -> usize {
 
 impl MechanicalSystem for CompliantModel {
     fn dof(&self) -> usize {
-        self.free.len()
+        self.coords.len()
     }
 
     fn eval(
@@ -429,7 +506,7 @@ impl MechanicalSystem for CompliantModel {
         let (x, xv, _) = self.full(t, q, v);
         let mut qf = vec![0.0; x.len()];
         let flows = self.forces(t, &x, &xv, &mut qf, &mut NoSink)?;
-        for (k, &i) in self.free.iter().enumerate() {
+        for (k, &i) in self.coords.iter().enumerate() {
             a[k] = qf[i] / self.mass[i];
         }
         let m = &self.parts;
@@ -440,7 +517,7 @@ impl MechanicalSystem for CompliantModel {
             }
             None => -self.prescribed.iter().map(|&p| qf[p] * xv[p]).sum::<f64>(),
         };
-        power[1] = m.load.torque(t) * xv[CARRIER];
+        power[1] = m.load.torque(t) * xv[self.load_index.unwrap_or(CARRIER)];
         power[2] = flows.dissipation;
         Ok(())
     }
@@ -452,14 +529,25 @@ impl MechanicalSystem for CompliantModel {
 
 impl ReducerModel for CompliantModel {
     fn free_mass(&self) -> Vec<f64> {
-        self.free.iter().map(|&i| self.mass[i]).collect()
+        self.coords.iter().map(|&i| self.mass[i]).collect()
     }
 
     fn generalized_force(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
+        let n = self.coords.len();
+        if q.len() != n || v.len() != n || out.len() != n {
+            // An analysis built on the reducer's coordinates alone meets a scene with shafts.
+            return Err(RvdynError::Scene(format!(
+                "the compliant model of this scene has {n} free coordinates ({} with machine \
+                 shafts: shafts.output / shafts.input), got {}: the analysis does not model the \
+                 shafts yet; set them to null for it",
+                n - self.free.len(),
+                q.len()
+            )));
+        }
         let (x, xv, _) = self.full(t, q, v);
         let mut qf = vec![0.0; x.len()];
         self.forces(t, &x, &xv, &mut qf, &mut NoSink)?;
-        for (k, &i) in self.free.iter().enumerate() {
+        for (k, &i) in self.coords.iter().enumerate() {
             out[k] = qf[i];
         }
         Ok(())
@@ -472,8 +560,8 @@ impl ReducerModel for CompliantModel {
     fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
         let (x, v) = self.full_initial_state();
         (
-            self.free.iter().map(|&i| x[i]).collect(),
-            self.free.iter().map(|&i| v[i]).collect(),
+            self.coords.iter().map(|&i| x[i]).collect(),
+            self.coords.iter().map(|&i| v[i]).collect(),
         )
     }
 
@@ -497,7 +585,22 @@ impl ReducerModel for CompliantModel {
                 .sum(),
         };
         let rot = |i: usize| crank_index(i) + 2;
+        let (sh, li, mi) = self.shafts(t, &x, &xv);
         Ok(Observation {
+            load_angle: x[li],
+            load_speed: xv[li],
+            motor_angle: x[mi],
+            motor_speed: xv[mi],
+            output_shaft_torque: if m.output_shaft.is_some() {
+                sh.output_torque
+            } else {
+                m.load.torque(t)
+            },
+            input_shaft_torque: if m.input_shaft.is_some() {
+                sh.input_torque
+            } else {
+                input_torque
+            },
             sun_angle: x[SUN],
             sun_speed: xv[SUN],
             carrier_angle: x[CARRIER],
