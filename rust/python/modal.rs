@@ -196,6 +196,22 @@ fn modes_state<'py>(
     point_dict(py, &p)
 }
 
+/// The rigid model's free coordinates as indices into `[carrier, crank, sun, load, motor]`
+/// (its `initial_state` order); `None` for compliant joints.
+#[pyfunction]
+fn rigid_coordinates(scene_json: &str) -> PyResult<Option<Vec<usize>>> {
+    let scene = Scene::from_json(scene_json)?;
+    if !matches!(scene.joints, crate::dynamics::scene::Joints::Rigid) {
+        return Ok(None);
+    }
+    let m = crate::dynamics::model::rigid::RigidModel::new(&scene)?;
+    Ok(Some(
+        crate::dynamics::model::rigid_system::RigidSystem::new(&m)
+            .coords
+            .clone(),
+    ))
+}
+
 /// Campbell diagram: natural frequencies over input speeds [rad/s] with the output torque at
 /// each speed [N m], at one crank angle [rad].
 #[pyfunction]
@@ -264,6 +280,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(campbell_crossings_py, m)?)?;
     m.add_function(wrap_pyfunction!(modes, m)?)?;
     m.add_function(wrap_pyfunction!(modes_state, m)?)?;
+    m.add_function(wrap_pyfunction!(rigid_coordinates, m)?)?;
     m.add_function(wrap_pyfunction!(campbell_diagram, m)?)?;
     Ok(())
 }
