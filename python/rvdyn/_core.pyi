@@ -44,6 +44,8 @@ __all__ = [
     "excitation_orders",
     "campbell_crossings",
     "modes",
+    "modes_state",
+    "rigid_coordinates",
     "campbell_diagram",
 ]
 
