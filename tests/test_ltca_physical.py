@@ -92,3 +92,14 @@ def test_physical_rigidity_is_the_twist_derivative() -> None:
     fd = 2 * dt / -(plus - minus)
     assert res.torsional_stiffness[0] == pytest.approx(fd, rel=1e-4)
     assert loop.rigidity > 0 and loop.backlash > 0 and loop.lost_motion > loop.backlash
+
+
+def test_physical_bad_input_is_a_clear_error() -> None:
+    scene = Scene.physical("rated")
+    with pytest.raises(rvdyn.ParameterError):
+        ltca(scene, RATED, [float("nan")])
+    with pytest.raises(rvdyn.ConvergenceError, match="crank angle"):
+        ltca(scene, 1e9, [0.1])
+    with pytest.raises(rvdyn.SceneError, match="profile_error"):
+        ltca(scene.replace(**{"discs": [{"phase": 0.0, "profile_error": {"harmonics": [[1e-6, 3, 0.0]]}},
+                                        {"phase": math.pi}]}), RATED, [0.0])

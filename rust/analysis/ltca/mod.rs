@@ -289,11 +289,12 @@ impl Ltca {
                     self.k_ref,
                     &self.options,
                     &mut self.work,
-                )?;
+                )
+                .map_err(|e| explain(st, e))?;
                 q = q2;
                 r
             }
-            Err(e) => return Err(e),
+            Err(e) => return Err(explain(st, e)),
         };
         self.before = self.last.take();
         self.last = Some(Solved {
@@ -519,6 +520,31 @@ impl Ltca {
         })
     }
 
+    /// The equilibrium at a torque `t` near zero (`|t|` far below `rated`): directly, or if
+    /// that fails (bodies floating in their clearances make the start from the kinematic pose
+    /// hard) by continuation from `1e-2 rated` on the same side down by factors of 10, each
+    /// step warm-started from the last.
+    fn solve_near_zero(
+        &mut self,
+        t: f64,
+        psi: f64,
+        rated: f64,
+    ) -> Result<(Vec<f64>, NewtonReport)> {
+        match self.solve_unknowns(t, psi) {
+            Ok(r) => Ok(r),
+            Err(e) => {
+                self.reset();
+                let mut level = 1e-2 * rated;
+                while level > t.abs() * 10.0 {
+                    self.solve_unknowns(level * t.signum(), psi)
+                        .map_err(|_| e.clone())?;
+                    level *= 0.1;
+                }
+                self.solve_unknowns(t, psi).map_err(|_| e)
+            }
+        }
+    }
+
     /// The torque-twist loop at crank angle `psi`: `points` torques along
     /// 0 -> +rated -> -rated -> 0 with rigidity, lost motion and backlash (catalogue
     /// definitions, docs/model.md).
@@ -559,7 +585,11 @@ impl Ltca {
             if t != 0.0 {
                 side = t.signum();
             }
-            let (q, _) = self.solve_unknowns(ts, psi)?;
+            let (q, _) = if t == 0.0 {
+                self.solve_near_zero(ts, psi, rated)?
+            } else {
+                self.solve_unknowns(ts, psi)?
+            };
             solved.push((ts, q.clone()));
             let x = self.statics.full(psi, &q);
             // Twist positive with positive torque: the load turns the output backwards.
@@ -581,6 +611,9 @@ impl Ltca {
                     q: q0.clone(),
                 });
             }
+            if t.abs() < 1e-6 * rated {
+                self.solve_near_zero(t, psi, rated)?;
+            }
             let (_, dev) = self.output_angle(t, psi)?;
             Ok(-dev)
         };
@@ -598,6 +631,22 @@ impl Ltca {
             backlash,
             tangent_stiffness: tangent,
         })
+    }
+}
+
+/// A convergence failure with a loaded line contact at the line law's depth switch gets the
+/// reason and the remedy added (the force jumps there: docs/model.md, "Laws the analysis
+/// linearises").
+fn explain(st: &Statics, e: RvdynError) -> RvdynError {
+    match (e, st.contact_at_depth_switch(0.01)) {
+        (RvdynError::Convergence(m), Some((k, j))) => RvdynError::Convergence(format!(
+            "{m}. Pin {} on disc {k} touches where the line-contact law switches the disc's \
+             reference depth (profile radius of curvature equal to the body depth): the \
+             contact force jumps there and an equilibrium may not exist; analyse a crank angle \
+             1e-3 rad away",
+            j + 1
+        )),
+        (e, _) => e,
     }
 }
 

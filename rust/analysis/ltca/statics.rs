@@ -221,6 +221,29 @@ pub struct Statics {
 impl Statics {
     /// Build from a scene (validated by the model).
     pub fn new(scene: &Scene) -> Result<Self> {
+        // Errors the statics do not model yet: say so rather than analyse another reducer.
+        let unsupported = if scene.discs.iter().any(|d| {
+            d.profile_error
+                .as_ref()
+                .is_some_and(|p| !p.harmonics.is_empty() || !p.table.is_empty())
+        }) {
+            Some("disc profile errors (discs[k].profile_error)")
+        } else if scene.gear_errors.any() {
+            Some("gear runout and pitch errors (gear_errors)")
+        } else if scene.errors.any() {
+            Some(
+                "assembly errors (errors: crank eccentricity and phase, disc holes, carrier seats)",
+            )
+        } else {
+            None
+        };
+        if let Some(what) = unsupported {
+            return Err(RvdynError::Scene(format!(
+                "the quasi-static analysis (LTCA, modes) does not include {what} yet: remove \
+                 them from the scene for this analysis (pin errors and profile modifications \
+                 are included)"
+            )));
+        }
         let mut rigid_scene = scene.clone();
         rigid_scene.joints = Joints::Rigid;
         let model = RigidModel::new(&rigid_scene)?;
@@ -341,6 +364,22 @@ impl Statics {
                     .fold(0.0, f64::max)
             }
         }
+    }
+
+    /// A (disc, pin) of the line law whose last contact (penetrating) lies within `margin`
+    /// (relative) of the law's switch of the disc reference depth, `kappa_P h = 1`, where the
+    /// location force jumps. `None` for the IMPACT laws.
+    pub fn contact_at_depth_switch(&self, margin: f64) -> Option<(usize, usize)> {
+        if !matches!(self.pin_law, PinLaw::Line { .. }) {
+            return None;
+        }
+        let zp = self.model.pins.len();
+        self.last_jets.iter().enumerate().find_map(|(slot, jet)| {
+            let k = slot / zp;
+            let depth = self.model.discs.get(k)?.body_depth;
+            let kp = 1.0 / (jet.curvature_radius);
+            (jet.gap < 0.0 && (kp * depth - 1.0).abs() < margin).then_some((k, slot % zp))
+        })
     }
 
     /// Number of unknowns.
