@@ -412,7 +412,7 @@ pub struct DepthJet {
 pub fn disc_reference_depth(kappa: f64, body_depth: f64) -> DepthJet {
     let w = DEPTH_BLEND_HALF_WIDTH;
     let u = kappa * body_depth;
-    if !(u > (-w).exp()) {
+    if u.is_nan() || u <= (-w).exp() {
         return DepthJet {
             depth: body_depth,
             dln_dkappa: 0.0,

@@ -446,7 +446,9 @@ pub fn line_jet_with(
     disc: &crate::contact::Material,
     ln_guess: f64,
 ) -> Result<LineJet> {
-    use crate::contact::line_contact::{LineContactLaw, pin_disc_profile_curvature};
+    use crate::contact::line_contact::{
+        LineContactLaw, disc_reference_depth, pin_disc_profile_curvature,
+    };
     let [kc, kc1, kc2] = curvature_derivatives_of(derivs);
     let r = geometry.generating_pin_radius();
     let kp = pin_disc_profile_curvature(kc, r)?;
@@ -466,11 +468,11 @@ pub fn line_jet_with(
     let sum = 1.0 / pin_radius + k2;
     let dln_r = -dk2 / sum;
     let d2ln_r = -d2k2 / sum + dk2 * dk2 / (sum * sum);
-    let (dln_h, d2ln_h) = if k2 * depth > 1.0 {
-        (-dk2 / k2, -d2k2 / k2 + dk2 * dk2 / (k2 * k2))
-    } else {
-        (0.0, 0.0)
-    };
+    let dj = disc_reference_depth(k2, depth);
+    let (dln_h, d2ln_h) = (
+        dj.dln_dkappa * dk2,
+        dj.dln_dkappa * d2k2 + dj.d2ln_dkappa2 * dk2 * dk2,
+    );
     let (c1, c2) = (pin.compliance(), disc.compliance());
     let pl = std::f64::consts::PI * geometry.params().face_width;
     Ok(LineJet {
@@ -742,7 +744,7 @@ mod tests {
     /// of the curvature). Steps 1e-5 rad (first) and 3e-5 rad (second difference): the
     /// truncation ~h^2 of the third derivative is largest near the sharp root (5e-4 relative
     /// at h = 1e-4), the energy round-off 1e-16 / h^2 stays below 1e-6: asserted 1e-4 of the largest value over a lobe (1e-6 for the models'
-    /// term), away from the kink where the disc's reference depth switches.
+    /// term), inside and outside the blend of the disc's reference depth.
     #[test]
     fn line_jet_matches_the_law() {
         use crate::contact::Material;

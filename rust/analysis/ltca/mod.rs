@@ -289,12 +289,11 @@ impl Ltca {
                     self.k_ref,
                     &self.options,
                     &mut self.work,
-                )
-                .map_err(|e| explain(st, e))?;
+                )?;
                 q = q2;
                 r
             }
-            Err(e) => return Err(explain(st, e)),
+            Err(e) => return Err(e),
         };
         self.before = self.last.take();
         self.last = Some(Solved {
@@ -631,22 +630,6 @@ impl Ltca {
             backlash,
             tangent_stiffness: tangent,
         })
-    }
-}
-
-/// A convergence failure with a loaded line contact at the line law's depth switch gets the
-/// reason and the remedy added (the force jumps there: docs/model.md, "Laws the analysis
-/// linearises").
-fn explain(st: &Statics, e: RvdynError) -> RvdynError {
-    match (e, st.contact_at_depth_switch(0.01)) {
-        (RvdynError::Convergence(m), Some((k, j))) => RvdynError::Convergence(format!(
-            "{m}. Pin {} on disc {k} touches where the line-contact law switches the disc's \
-             reference depth (profile radius of curvature equal to the body depth): the \
-             contact force jumps there and an equilibrium may not exist; analyse a crank angle \
-             1e-3 rad away",
-            j + 1
-        )),
-        (e, _) => e,
     }
 }
 

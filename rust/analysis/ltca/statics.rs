@@ -366,22 +366,6 @@ impl Statics {
         }
     }
 
-    /// A (disc, pin) of the line law whose last contact (penetrating) lies within `margin`
-    /// (relative) of the law's switch of the disc reference depth, `kappa_P h = 1`, where the
-    /// location force jumps. `None` for the IMPACT laws.
-    pub fn contact_at_depth_switch(&self, margin: f64) -> Option<(usize, usize)> {
-        if !matches!(self.pin_law, PinLaw::Line { .. }) {
-            return None;
-        }
-        let zp = self.model.pins.len();
-        self.last_jets.iter().enumerate().find_map(|(slot, jet)| {
-            let k = slot / zp;
-            let depth = self.model.discs.get(k)?.body_depth;
-            let kp = 1.0 / (jet.curvature_radius);
-            (jet.gap < 0.0 && (kp * depth - 1.0).abs() < margin).then_some((k, slot % zp))
-        })
-    }
-
     /// Number of unknowns.
     pub fn dim(&self) -> usize {
         self.scale.len()
