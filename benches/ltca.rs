@@ -1,6 +1,7 @@
 //! Quasi-static analysis speed: LTCA of one crank angle, a mesh period at 360 crank angles and a
 //! 200-point torque-twist loop, on the paper's scene with compliant bearings and the line
-//! (Palmgren) pin law at rated torque.
+//! (Palmgren) pin law at rated torque, and on the physical preset (line-contact pins, ISO 6336
+//! meshes, roller bearings with clearance) at rated torque (`ltca_physical/...`).
 use criterion::{Criterion, criterion_group, criterion_main};
 use rvdyn::analysis::ltca::Ltca;
 use rvdyn::dynamics::compliant::default_joints;
@@ -51,9 +52,35 @@ fn bench_ltca(c: &mut Criterion) {
     });
 }
 
+fn bench_ltca_physical(c: &mut Criterion) {
+    let s = Scene::physical("rated").expect("physical scene");
+    let torque = s.load.torque(0.0);
+    let mut ltca = Ltca::new(&s).expect("ltca");
+    let period = ltca.mesh_period();
+    let angles: Vec<f64> = (0..360).map(|i| period * i as f64 / 360.0).collect();
+    ltca.solve(torque, 0.0).expect("first angle");
+    let mut k = 0usize;
+    c.bench_function("ltca_physical/one_crank_angle_warm", |b| {
+        b.iter(|| {
+            k += 1;
+            let psi = period * (k % 360) as f64 / 360.0;
+            black_box(ltca.solve(black_box(torque), psi).expect("solve"))
+        })
+    });
+    c.bench_function("ltca_physical/mesh_period_360_angles", |b| {
+        b.iter(|| {
+            ltca.reset();
+            black_box(ltca.sweep(black_box(torque), &angles).expect("sweep"))
+        })
+    });
+    c.bench_function("ltca_physical/twist_loop_200_points", |b| {
+        b.iter(|| black_box(ltca.twist_loop(black_box(torque), 0.0, 200).expect("loop")))
+    });
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = bench_ltca
+    targets = bench_ltca, bench_ltca_physical
 }
 criterion_main!(benches);

@@ -1,6 +1,7 @@
 //! Criterion benches of the vibration analyses: the modal analysis of the compliant model at
 //! one operating point (linearisation about the LTCA equilibrium + eigen-analysis), the
-//! eigen-analysis alone, and a Campbell diagram over 200 input speeds.
+//! eigen-analysis alone, and a Campbell diagram over 200 input speeds; the modes of the
+//! physical preset at one operating point (`modal/physical_16dof_point`).
 use criterion::{Criterion, criterion_group, criterion_main};
 use rvdyn::analysis::modal::{Linearizer, campbell, modal_analysis, modes_at};
 use rvdyn::dynamics::Scene;
@@ -25,6 +26,15 @@ fn bench_modal(c: &mut Criterion) {
             flip = !flip;
             let psi = if flip { 0.10 } else { 0.11 };
             black_box(modes_at(&mut lin, RATED, black_box(psi)).expect("modes"))
+        })
+    });
+    let physical = Scene::physical("rated").expect("physical scene");
+    let mut lin_p = Linearizer::new(&physical).expect("linearizer");
+    c.bench_function("modal/physical_16dof_point", |b| {
+        b.iter(|| {
+            flip = !flip;
+            let psi = if flip { 0.10 } else { 0.11 };
+            black_box(modes_at(&mut lin_p, RATED, black_box(psi)).expect("modes"))
         })
     });
     let (sys, _) = lin.linearise(RATED, 0.1).expect("linearise");

@@ -141,5 +141,10 @@ def test_analyze_command_writes_figures_loads_and_summary(tmp_path: Path) -> Non
                  "torque_twist.png", "fea_loads.csv", "fea_loads.json", "summary.md", "summary.json"):
         assert (out / name).exists(), name
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["rigidity_Nm_per_arcmin"] > 0
+    assert summary["rigidity_Nm_per_arcmin"] > 0 and summary["scene"] == "physical"
     assert "LTCA: 12/12" in r.stderr
+    # The paper preset by flag.
+    r = subprocess.run([sys.executable, "-m", "rvdyn", "analyze", "--preset", "paper", "--out", str(out),
+                        "--angles", "6", "--loop-points", "21"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert json.loads((out / "summary.json").read_text())["scene"] == "paper"

@@ -146,9 +146,14 @@ def test_bad_requests() -> None:
 
 def test_cli_modes_writes_table_energy_campbell_and_summary(tmp_path, capsys) -> None:
     out = tmp_path / "out"
+    # Default: the physical preset (compliant joints: one mode per free coordinate).
     assert main(["modes", "--out", str(out), "--points", "5", "--power", "112e3"]) == 0
     for name in ("modes.md", "modes.json", "modes_energy.png", "modes_mesh_period.png", "campbell.png"):
         assert (out / name).exists(), name
+    data = json.loads((out / "modes.json").read_text())
+    assert len(data["modes"]) == 16 and data["joints"] == "compliant"
+    # The paper preset by flag: rigid joints, two modes.
+    assert main(["modes", "--preset", "paper", "--out", str(out), "--points", "5", "--power", "112e3"]) == 0
     data = json.loads((out / "modes.json").read_text())
     assert len(data["modes"]) == 2 and data["joints"] == "rigid"
     assert "Mode table" in (out / "modes.md").read_text()

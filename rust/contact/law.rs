@@ -8,7 +8,7 @@
 use crate::contact::damping::{HysteresisDamping, HysteresisModel, StiffnessProportionalDamping};
 use crate::contact::hertz::Material;
 use crate::contact::impact::ImpactLaw;
-use crate::contact::line_contact::LineContactLaw;
+use crate::contact::line_contact::{LineContactLaw, disc_reference_depth};
 use crate::error::{Result, RvdynError, require_positive};
 use crate::gear::iso6336::{IsoGearPair, MeshStiffnessWave, base_pitch, spur_contact_ratio};
 use crate::geometry::CycloidGeometry;
@@ -79,6 +79,19 @@ impl ContactDamping {
         match self {
             Self::Hysteresis(h) => h.force(elastic, rate),
             Self::Proportional(p) => (elastic + p.beta * stiffness * rate).max(0.0),
+        }
+    }
+}
+
+impl ContactDamping {
+    /// Damping coefficient `dF/d(rate)` [N s/m] at zero rate for the elastic force `elastic`
+    /// [N] and its tangent stiffness `stiffness` [N/m] (0 without contact): the contact's part
+    /// of a linearised damping matrix.
+    #[inline]
+    pub fn rate_coefficient(&self, elastic: f64, stiffness: f64) -> f64 {
+        match self {
+            Self::Hysteresis(h) => h.force_and_derivatives(elastic, stiffness, 0.0).2,
+            Self::Proportional(p) => p.force_and_derivatives(elastic, stiffness, 0.0, 0.0).2,
         }
     }
 }
@@ -281,11 +294,7 @@ impl PinLaw {
         let dk2 = dkc / (den * den);
         let k1 = 1.0 / site.pin_radius;
         let dln_r = -dk2 / (k1 + k2);
-        let dln_h2 = if k2 * site.depth > 1.0 {
-            -dk2 / k2
-        } else {
-            0.0
-        };
+        let dln_h2 = disc_reference_depth(k2, site.depth).dln_dkappa * dk2;
         let (c1, c2) = (pin.compliance(), disc.compliance());
         let length = g.params().face_width;
         let dk0 = (2.0 * c2 * dln_h2 - (c1 + c2) * dln_r) / (std::f64::consts::PI * length);

@@ -177,8 +177,9 @@ impl LineContactLaw {
     /// dimension (e.g. the distance from the disc centre to the contact): near a profile
     /// inflection the radius of curvature is unbounded, while the disc is not. Where the
     /// profile is concave or flat there is no solid cylinder on the disc side: the seat is
-    /// backed by the disc body, and the depth is `disc_depth`. Both branches meet at the
-    /// inflection, so the law is continuous along the profile.
+    /// backed by the disc body, and the depth is `disc_depth`. The switch between the two
+    /// branches is blended (see [`disc_reference_depth`]), so the law and its derivatives
+    /// along the profile are continuous.
     ///
     /// Errors as [`LineContactLaw::new`].
     pub fn pin_disc(
@@ -196,11 +197,7 @@ impl LineContactLaw {
                 "profile curvature must be finite (1/m), got {profile_curvature}"
             )));
         }
-        let h2 = if profile_curvature * disc_depth > 1.0 {
-            1.0 / profile_curvature
-        } else {
-            disc_depth
-        };
+        let h2 = disc_reference_depth(profile_curvature, disc_depth).depth;
         Self::new(
             face_width,
             1.0 / pin_radius,
@@ -418,6 +415,70 @@ impl LineContactLaw {
         }
         let f = self.force(delta);
         f * delta - integral_below(f)
+    }
+}
+
+/// Half-width `w` of the blend of the disc's reference depth, in `ln(kappa D)`: the two
+/// branches are blended for `kappa D` in `[e^-w, e^w] = [0.8, 1.25]`.
+pub const DEPTH_BLEND_HALF_WIDTH: f64 = 0.223_143_551_314_209_76; // ln 1.25
+
+/// The disc's reference depth at a contact and its derivatives along the curvature.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DepthJet {
+    /// Reference depth `h` [m].
+    pub depth: f64,
+    /// `d ln h / d kappa` [m].
+    pub dln_dkappa: f64,
+    /// `d^2 ln h / d kappa^2` [m^2].
+    pub d2ln_dkappa2: f64,
+}
+
+/// Reference depth `h` of the disc side of a pin contact, for the signed profile curvature
+/// `kappa` [1/m] and the body depth `body_depth` `D` [m] (docs/model.md, "Pin against cycloid
+/// disc"): `h = D` where `kappa D <= 0.8` (concave, flat or gently convex: the seat is backed
+/// by the body), `h = 1/kappa` where `kappa D >= 1.25` (the cylinder of the actual radius), and
+/// between them `ln h = ln D - r(ln(kappa D))` with the C2 ramp
+/// `r(x) = w [(1 + t)/2 + (15/16)(t^2/2 - t^4/6 + t^6/30 - 11/30)]`, `t = x/w`, whose second
+/// derivative is the quartic kernel `(15/(16 w))(1 - t^2)^2`. A plain `min(1/kappa, D)` has a
+/// kink at `kappa D = 1`, which makes the location force of the law jump where a loaded contact
+/// crosses it (no static equilibrium exists there); the ramp keeps that force and its tangent
+/// continuous. Returns `h` and `d ln h/d kappa`, `d^2 ln h/d kappa^2`.
+///
+/// ```
+/// use rvdyn::contact::line_contact::disc_reference_depth;
+/// let d = 0.14;
+/// assert_eq!(disc_reference_depth(-5.0, d).depth, d); // concave: backed by the body
+/// let convex = disc_reference_depth(1.0 / 0.094, d); // kappa D = 1.49
+/// assert!((convex.depth - 0.094).abs() < 1e-15);
+/// ```
+pub fn disc_reference_depth(kappa: f64, body_depth: f64) -> DepthJet {
+    let w = DEPTH_BLEND_HALF_WIDTH;
+    let u = kappa * body_depth;
+    if u.is_nan() || u <= (-w).exp() {
+        return DepthJet {
+            depth: body_depth,
+            dln_dkappa: 0.0,
+            d2ln_dkappa2: 0.0,
+        };
+    }
+    let x = u.ln();
+    let (r, r1, r2) = if x >= w {
+        (x, 1.0, 0.0)
+    } else {
+        let t = x / w;
+        let t2 = t * t;
+        let r = w
+            * (0.5 * (1.0 + t)
+                + (15.0 / 16.0) * (0.5 * t2 - t2 * t2 / 6.0 + t2 * t2 * t2 / 30.0 - 11.0 / 30.0));
+        let r1 = 0.5 + (15.0 / 16.0) * (t - 2.0 * t2 * t / 3.0 + t2 * t2 * t / 5.0);
+        let r2 = (15.0 / (16.0 * w)) * (1.0 - t2) * (1.0 - t2);
+        (r, r1, r2)
+    };
+    // x = ln(kappa D): dx/dkappa = 1/kappa, d2x/dkappa2 = -1/kappa^2.
+    DepthJet {
+        depth: body_depth * (-r).exp(),
+        dln_dkappa: -r1 / kappa,
+        d2ln_dkappa2: (r1 - r2) / (kappa * kappa),
     }
 }
 
@@ -664,5 +725,59 @@ mod tests {
             100.0,
             1e-12
         ));
+    }
+
+    #[test]
+    fn disc_depth_blend_is_twice_differentiable_and_exact_outside() {
+        let d = 0.14;
+        let w = DEPTH_BLEND_HALF_WIDTH;
+        // Outside the blend: the two branches exactly.
+        assert_eq!(disc_reference_depth(0.0, d).depth, d);
+        assert_eq!(disc_reference_depth(0.79 / d, d).depth, d);
+        let k = 1.26 / d;
+        assert!(close(disc_reference_depth(k, d).depth, 1.0 / k, 1e-15));
+        // Inside: between the two branches, and the derivatives equal central differences
+        // (step 1e-5 of kappa; tolerance 1e-6 relative, the truncation error of the difference).
+        let mut prev = d;
+        for i in 0..=200 {
+            let u = (-w).exp() + ((w).exp() - (-w).exp()) * i as f64 / 200.0;
+            let k = u / d;
+            let j = disc_reference_depth(k, d);
+            assert!(
+                j.depth <= d && j.depth >= (1.0 / k).min(d) * 0.96,
+                "u {u}: {}",
+                j.depth
+            );
+            assert!(j.depth <= prev + 1e-18, "monotone");
+            prev = j.depth;
+            let h = 1e-5 * k;
+            let (a, b) = (
+                disc_reference_depth(k + h, d),
+                disc_reference_depth(k - h, d),
+            );
+            let d1 = (a.depth.ln() - b.depth.ln()) / (2.0 * h);
+            let d2 = (a.dln_dkappa - b.dln_dkappa) / (2.0 * h);
+            let scale = 1.0 / k;
+            assert!(
+                (d1 - j.dln_dkappa).abs() < 1e-6 * scale,
+                "u {u}: {d1} vs {}",
+                j.dln_dkappa
+            );
+            assert!(
+                (d2 - j.d2ln_dkappa2).abs() < 1e-6 * scale * scale,
+                "u {u}: {d2} vs {}",
+                j.d2ln_dkappa2
+            );
+        }
+        // Value, slope and curvature continuous at both ends of the blend.
+        for u in [(-w).exp(), w.exp()] {
+            let (lo, hi) = (
+                disc_reference_depth((u - 1e-12) / d, d),
+                disc_reference_depth((u + 1e-12) / d, d),
+            );
+            assert!(close(lo.depth, hi.depth, 1e-10));
+            assert!((lo.dln_dkappa - hi.dln_dkappa).abs() < 1e-9 * d);
+            assert!((lo.d2ln_dkappa2 - hi.d2ln_dkappa2).abs() < 1e-8 * d * d);
+        }
     }
 }

@@ -350,6 +350,36 @@ impl MeshStiffnessWave {
     }
 }
 
+impl MeshStiffnessWave {
+    /// Stiffness `k(s)` [N/m], slope `dk/ds` [N/m^2] and curvature `d2k/ds2` [N/m^3] at the
+    /// mesh position `s` [m]: the derivatives of [`MeshStiffnessWave::stiffness_and_slope`]'s
+    /// ramps `3 x^2 - 2 x^3` (`x` the position within a ramp), for the static tangent of the
+    /// mesh energy `V = k(s) pen^2 / 2` (quasi-static analysis, modes). The curvature jumps at
+    /// the ends of each ramp (the ramp is C1); it is that of the side `s` lies on.
+    pub fn stiffness_slope_curvature(&self, s: f64) -> (f64, f64, f64) {
+        let (k, dk) = self.stiffness_and_slope(s);
+        let f = self.high_fraction;
+        let w = self.ramp;
+        if !s.is_finite() || f == 0.0 || w == 0.0 {
+            return (k, dk, 0.0);
+        }
+        let u = (s / self.base_pitch).rem_euclid(1.0);
+        let v = if u < 0.5 * (1.0 + f) { u } else { u - 1.0 };
+        // d2/dt2 of the smooth step at t (in base pitches): 6 (1 - 2 x) / w^2 inside the ramp.
+        let curv = |t: f64| {
+            let x = t / w + 0.5;
+            if x <= 0.0 || x >= 1.0 {
+                0.0
+            } else {
+                6.0 * (1.0 - 2.0 * x) / (w * w)
+            }
+        };
+        let span = self.high - self.low;
+        let d2 = span * (curv(v) - curv(v - f)) / (self.base_pitch * self.base_pitch);
+        (k, dk, d2)
+    }
+}
+
 /// Mesh phases of the sun-planet meshes of a planetary stage, as fractions of a mesh period in
 /// [0, 1): `gamma_k = frac(z_sun psi_k / (2 pi))` for planets at the angles `psi_k` [rad]
 /// (measured in the direction of the sun's rotation relative to the carrier).
@@ -540,5 +570,36 @@ mod tests {
         assert!(MeshStiffnessWave::new(-1.0, 1.6, 1e-2, 0.0).is_err());
         assert!(rim_blank_factor(0.0, 0.03, 6e-3, 3e-3).is_err());
         assert!(spur_contact_ratio(18, 42, -1.0, 0.3).is_err());
+    }
+
+    /// The curvature `d2k/ds2` equals central differences of the slope (step 1e-9 base
+    /// pitches; inside a ramp the slope is a quadratic, so the difference is exact up to
+    /// round-off: slope ~ span / (w pb) ~ 1e10 N/m^2 with ~1e-6 relative round-off over
+    /// a 1e-11 m step gives ~1e-5 of the curvature scale span / (w pb)^2; asserted 1e-4),
+    /// away from the ramp ends, where it jumps.
+    #[test]
+    fn stiffness_curvature_is_the_slope_derivative() {
+        let w = MeshStiffnessWave::new(2e8, 1.6, 1e-2, 0.05).unwrap();
+        let pb = 1e-2;
+        let scale = (w.high - w.low) / (0.05 * 0.05 * pb * pb);
+        let mut inside = 0;
+        for i in 0..4000 {
+            let s = -0.013 + 3.0 * pb * i as f64 / 4000.0;
+            let u = (s / pb).rem_euclid(1.0);
+            let near_end = [0.0, 0.6, 1.0]
+                .iter()
+                .any(|e| ((u - e).abs() - 0.025).abs() < 1e-4);
+            if near_end {
+                continue;
+            }
+            let h = 1e-9 * pb;
+            let fd = (w.stiffness_and_slope(s + h).1 - w.stiffness_and_slope(s - h).1) / (2.0 * h);
+            let (_, _, d2) = w.stiffness_slope_curvature(s);
+            if d2 != 0.0 {
+                inside += 1;
+            }
+            assert!((fd - d2).abs() < 1e-4 * scale, "s = {s}: {fd} vs {d2}");
+        }
+        assert!(inside > 100, "{inside}");
     }
 }

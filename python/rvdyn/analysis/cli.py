@@ -14,7 +14,10 @@ __all__ = ["add_arguments", "run"]
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``rvdyn analyze``."""
     p.add_argument("scene", nargs="?", default=None,
-                   help="scene file (.json or .toml; default: the paper's scene at rated load)")
+                   help="scene file (.json or .toml); default: the preset chosen by --preset at rated load")
+    p.add_argument("--preset", choices=("physical", "paper"), default="physical",
+                   help="preset used without a scene file (default physical: line-contact pins, ISO "
+                   "6336 meshes, roller bearings; paper: the paper's IMPACT laws, rigid joints)")
     p.add_argument("--torque", type=float, default=None, metavar="NM",
                    help="output torque [N m] (default: the scene's constant load)")
     p.add_argument("--angles", type=int, default=90, metavar="N",
@@ -37,7 +40,10 @@ def run(args: argparse.Namespace) -> int:
     from ..scene import Scene
     from .ltca import ARCMIN, ARCSEC, ltca, torque_twist, transmission_error
 
-    scene = Scene.paper("rated") if args.scene is None else Scene.load(args.scene)
+    if args.scene is not None:
+        scene = Scene.load(args.scene)
+    else:
+        scene = Scene.physical("rated") if args.preset == "physical" else Scene.paper("rated")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"rvdyn analyze: scene {scene['name'] or '(unnamed)'}, writing to {out}/", file=sys.stderr)
@@ -58,6 +64,7 @@ def run(args: argparse.Namespace) -> int:
     csv_path, json_path = res.save_fea_loads(out)
     pp = te.peak_to_peak()
     summary = {
+        "scene": scene["name"],
         "torque_Nm": res.torque,
         "mesh_period_rad": period,
         **res.summary(),

@@ -186,9 +186,7 @@ impl Ltca {
     pub fn with_options(scene: &Scene, options: NewtonOptions) -> Result<Self> {
         require_finite("tolerance", options.tolerance)?;
         let statics = Statics::new(scene)?;
-        let law = statics.pin_law;
-        let (f, _) = statics::elastic(&law, 1e-5);
-        let mut k_ref = f / 1e-5;
+        let mut k_ref = statics.pin_secant_stiffness(1e-5);
         if let Some(b) = &statics.eccentric_bearing {
             // The bearing's stiffness at a 1 mm deflection (beyond any clearance it has).
             k_ref = k_ref.max(b.static_tangent([1e-3, 0.0]).1[0][0]);
@@ -376,7 +374,10 @@ impl Ltca {
         let kin = st.kinematic_full(psi);
         let m = &st.model;
         let zp = m.pins.len();
-        let steel = Material::steel();
+        let (pin_mat, disc_mat) = match &m.pin_law {
+            crate::contact::law::PinLaw::Line { pin, disc, .. } => (*pin, *disc),
+            _ => (Material::steel(), Material::steel()),
+        };
         let mut pins = Vec::with_capacity(m.discs.len());
         let mut loaded = Vec::new();
         let mut rot = Vec::new();
@@ -409,8 +410,8 @@ impl Ltca {
                         self.face_width,
                         m.pins[j].radius,
                         jet.curvature_radius,
-                        &steel,
-                        &steel,
+                        &pin_mat,
+                        &disc_mat,
                     )
                     .map_or((0.0, 0.0), |h| (h.half_width, h.peak_pressure))
                 } else {
@@ -436,8 +437,11 @@ impl Ltca {
             rot.push(th - kin[dk + 2]);
             disp.push([x[dk] - kin[dk], x[dk + 1] - kin[dk + 1]]);
         }
+        // The line law's location term acts on the discs too (its reaction on the pins).
+        pin_moment += cs.pin_location_moment.iter().sum::<f64>();
         let input_torque = st.input_reaction(&self.work);
-        let balance = (input_torque - torque + pin_moment).abs() / torque.abs().max(1.0);
+        let balance =
+            (input_torque - torque + pin_moment + cs.bearing_couple).abs() / torque.abs().max(1.0);
         let input_angle = if m.mesh.is_some() {
             st.held_input(psi)
         } else {
@@ -515,6 +519,31 @@ impl Ltca {
         })
     }
 
+    /// The equilibrium at a torque `t` near zero (`|t|` far below `rated`): directly, or if
+    /// that fails (bodies floating in their clearances make the start from the kinematic pose
+    /// hard) by continuation from `1e-2 rated` on the same side down by factors of 10, each
+    /// step warm-started from the last.
+    fn solve_near_zero(
+        &mut self,
+        t: f64,
+        psi: f64,
+        rated: f64,
+    ) -> Result<(Vec<f64>, NewtonReport)> {
+        match self.solve_unknowns(t, psi) {
+            Ok(r) => Ok(r),
+            Err(e) => {
+                self.reset();
+                let mut level = 1e-2 * rated;
+                while level > t.abs() * 10.0 {
+                    self.solve_unknowns(level * t.signum(), psi)
+                        .map_err(|_| e.clone())?;
+                    level *= 0.1;
+                }
+                self.solve_unknowns(t, psi).map_err(|_| e)
+            }
+        }
+    }
+
     /// The torque-twist loop at crank angle `psi`: `points` torques along
     /// 0 -> +rated -> -rated -> 0 with rigidity, lost motion and backlash (catalogue
     /// definitions, docs/model.md).
@@ -555,7 +584,11 @@ impl Ltca {
             if t != 0.0 {
                 side = t.signum();
             }
-            let (q, _) = self.solve_unknowns(ts, psi)?;
+            let (q, _) = if t == 0.0 {
+                self.solve_near_zero(ts, psi, rated)?
+            } else {
+                self.solve_unknowns(ts, psi)?
+            };
             solved.push((ts, q.clone()));
             let x = self.statics.full(psi, &q);
             // Twist positive with positive torque: the load turns the output backwards.
@@ -576,6 +609,9 @@ impl Ltca {
                     torque: *t0,
                     q: q0.clone(),
                 });
+            }
+            if t.abs() < 1e-6 * rated {
+                self.solve_near_zero(t, psi, rated)?;
             }
             let (_, dev) = self.output_angle(t, psi)?;
             Ok(-dev)
@@ -605,16 +641,38 @@ impl Ltca {
 /// identical pins the pattern repeats every `2 pi / zp` of crank angle (both discs at once:
 /// their phases only shift the pattern). Pin errors make pins distinguishable: a pin returns to
 /// the same lobe position only after the shift is a whole number of rings, `2 pi` of crank
-/// angle. (The first stage's mesh law does not vary with the tooth position in the scene's
-/// laws, so it adds no period.)
+/// angle. An IMPACT mesh law does not vary with the tooth position; the ISO 6336 stiffness
+/// varies with the mesh position `s = r_bs (th_s - th_c)` with the period of one base pitch,
+/// which the held sun passes every `2 pi zc / (z_planet zp)` of crank angle
+/// (`th_s - th_c = -(z_planet / z_sun)(1 + 1/zc) psi` with the input held): the pattern then
+/// repeats after the least common multiple of both periods, counted in units of
+/// `2 pi / (z_planet zp)`.
 pub fn mesh_period(scene: &Scene) -> f64 {
     let e = &scene.pin_errors;
     let errors =
         e.position.iter().any(|p| p[0] != 0.0 || p[1] != 0.0) || e.radius.iter().any(|r| *r != 0.0);
-    if errors {
-        TAU
-    } else {
-        TAU / f64::from(scene.cycloid.pins)
+    let zp = u64::from(scene.cycloid.pins);
+    let pins = if errors { TAU } else { TAU / zp as f64 };
+    let iso = matches!(
+        scene.contact.mesh,
+        crate::dynamics::scene::ContactLawSpec::Iso6336 { .. }
+    );
+    match (&scene.stage1, iso) {
+        (Some(st), true) => {
+            let zpl = u64::from(st.z_planet);
+            let unit = TAU / (zpl * zp) as f64;
+            let pin_units = if errors { zpl * zp } else { zpl };
+            let mesh_units = zp - 1;
+            let gcd = |mut a: u64, mut b: u64| {
+                while b != 0 {
+                    (a, b) = (b, a % b);
+                }
+                a
+            };
+            let lcm = pin_units / gcd(pin_units, mesh_units) * mesh_units;
+            unit * lcm as f64
+        }
+        _ => pins,
     }
 }
 

@@ -75,7 +75,7 @@ impl Default for NewtonOptions {
     fn default() -> Self {
         Self {
             tolerance: 1e-12,
-            max_iterations: 60,
+            max_iterations: 200,
         }
     }
 }

@@ -23,7 +23,9 @@ use std::f64::consts::TAU;
 
 use crate::contact::ImpactLaw;
 use crate::contact::law::{MeshLaw, PinLaw};
-use crate::contact::pin_tangent::{GapJet, gap_jet_cs};
+use crate::contact::pin_tangent::{
+    GapJet, centre_curve_derivatives_cs, foot_jet_with, gap_jet_cs, line_jet, line_jet_with,
+};
 use crate::dynamics::model::laws::{BearingLaw, ContactLaw};
 use crate::dynamics::rigid::RigidModel;
 use crate::dynamics::scene::{Joints, Scene};
@@ -94,6 +96,15 @@ impl Dense {
             }
         }
     }
+    /// Add `w (u v^T + v u^T)` on the index set `idx` (`u`, `v` given on `idx`).
+    #[inline]
+    fn outer_sym(&mut self, idx: &[usize], u: &[f64], v: &[f64], w: f64) {
+        for (a, &i) in idx.iter().enumerate() {
+            for (b, &j) in idx.iter().enumerate() {
+                self.a[i * self.n + j] += w * (u[a] * v[b] + v[a] * u[b]);
+            }
+        }
+    }
     /// Add `v` to the symmetric pair `(i, j)`, `(j, i)` (once on the diagonal).
     #[inline]
     fn sym(&mut self, i: usize, j: usize, v: f64) {
@@ -113,6 +124,13 @@ pub struct ContactState {
     pub pin_gap: Vec<f64>,
     /// The gap jets (contact point, normal, curvature) per disc and pin.
     pub pin_jet: Vec<GapJet>,
+    /// Moment about the reducer axis of the line law's location term on each disc, per disc
+    /// and pin [N m] (0 for IMPACT): `O x Q_O + Q_theta` of `Q = -U_phi grad phi`.
+    pub pin_location_moment: Vec<f64>,
+    /// Sum over the bearings of the couple `d x F` of each bearing's force pair [N m]: zero
+    /// for an isotropic law (force along the deflection); the roller laws, with their roller
+    /// sets fixed in the frame, push slightly off the deflection.
+    pub bearing_couple: f64,
     /// Signed mesh force along the line of action per crank [N] (positive: drive flank).
     pub mesh_force: Vec<f64>,
     /// Mesh deflection along the line of action per crank [m].
@@ -160,10 +178,12 @@ pub struct Statics {
     pub crank_bearing: Option<BearingLaw>,
     /// Number of cranks.
     pub cranks: usize,
-    /// The pin law (IMPACT or Palmgren).
-    pub pin_law: ImpactLaw,
-    /// The mesh law (IMPACT; unused without a first stage).
-    pub mesh_law: ImpactLaw,
+    /// The pin law (IMPACT, Palmgren or line contact).
+    pub pin_law: PinLaw,
+    /// The mesh law (IMPACT or ISO 6336; `None` without a first stage).
+    pub mesh_law: Option<MeshLaw>,
+    /// `ln F` of each (disc, pin)'s last line-law force (warm start of its inversion).
+    ln_warm: Vec<f64>,
     seats: Vec<[f64; 2]>,
     holes: Vec<[f64; 2]>,
     /// `(sin, cos)` of the pressure angle.
@@ -201,6 +221,29 @@ pub struct Statics {
 impl Statics {
     /// Build from a scene (validated by the model).
     pub fn new(scene: &Scene) -> Result<Self> {
+        // Errors the statics do not model yet: say so rather than analyse another reducer.
+        let unsupported = if scene.discs.iter().any(|d| {
+            d.profile_error
+                .as_ref()
+                .is_some_and(|p| !p.harmonics.is_empty() || !p.table.is_empty())
+        }) {
+            Some("disc profile errors (discs[k].profile_error)")
+        } else if scene.gear_errors.any() {
+            Some("gear runout and pitch errors (gear_errors)")
+        } else if scene.errors.any() {
+            Some(
+                "assembly errors (errors: crank eccentricity and phase, disc holes, carrier seats)",
+            )
+        } else {
+            None
+        };
+        if let Some(what) = unsupported {
+            return Err(RvdynError::Scene(format!(
+                "the quasi-static analysis (LTCA, modes) does not include {what} yet: remove \
+                 them from the scene for this analysis (pin errors and profile modifications \
+                 are included)"
+            )));
+        }
         let mut rigid_scene = scene.clone();
         rigid_scene.joints = Joints::Rigid;
         let model = RigidModel::new(&rigid_scene)?;
@@ -215,31 +258,10 @@ impl Statics {
                 crank_bearing.as_ref().map(BearingLaw::new).transpose()?,
             ),
         };
-        // The tangent is analytic for the IMPACT-type laws (the paper's and Palmgren's); the
-        // physical model's line law and ISO mesh stiffness are not linearised yet.
-        let pin_law = match &model.pin_law {
-            PinLaw::Impact(l) => *l,
-            _ => {
-                return Err(RvdynError::Scene(
-                    "the quasi-static analysis supports the IMPACT and Palmgren pin laws so far; \
-                     the line-contact law is not linearised yet: set contact.pin to an \
-                     \"impact\" or \"palmgren\" law"
-                        .into(),
-                ));
-            }
-        };
-        let mesh_law = match model.mesh.as_ref().map(|m| &m.law) {
-            None => pin_law,
-            Some(MeshLaw::Impact(l)) => *l,
-            Some(_) => {
-                return Err(RvdynError::Scene(
-                    "the quasi-static analysis supports the IMPACT mesh law so far; the ISO \
-                     6336 mesh stiffness is not linearised yet: set contact.mesh to an \
-                     \"impact\" law"
-                        .into(),
-                ));
-            }
-        };
+        // Every law of the models has an analytic static tangent: IMPACT/Palmgren, the line
+        // contact with its location term, the ISO 6336 mesh stiffness wave.
+        let pin_law = model.pin_law;
+        let mesh_law = model.mesh.as_ref().map(|m| m.law);
         let n = model.cranks;
         let nd = model.discs.len();
         let seats: Vec<[f64; 2]> = (0..n).map(|i| cos_sin(TAU * i as f64 / n as f64)).collect();
@@ -300,6 +322,7 @@ impl Statics {
             unknowns,
             scale,
             warm: vec![0.0; nd * zp],
+            ln_warm: vec![f64::NAN; nd * zp],
             max_penetration: 0.0,
             evaluations: 0,
             skip: true,
@@ -319,6 +342,28 @@ impl Statics {
                 * 1.000_001,
             model,
         })
+    }
+
+    /// Secant stiffness `F(pen) / pen` [N/m] of the pin law at the approach `pen` [m] (the
+    /// stiffest place along a lobe of disc 0 for the line law): a reference stiffness for the
+    /// solver's scaling.
+    pub fn pin_secant_stiffness(&self, pen: f64) -> f64 {
+        match &self.pin_law {
+            PinLaw::Impact(l) => elastic(l, pen).0 / pen,
+            PinLaw::Line { pin, disc, .. } => {
+                let d = &self.model.discs[0];
+                let pr = self.model.pins[0].radius;
+                let lobe = TAU / self.zc();
+                (0..16)
+                    .filter_map(|i| {
+                        let phi = lobe * (i as f64 + 0.5) / 16.0;
+                        line_jet(&d.geometry, phi, pen, pr, d.body_depth, pin, disc, f64::NAN)
+                            .ok()
+                            .map(|j| j.force / pen)
+                    })
+                    .fold(0.0, f64::max)
+            }
+        }
     }
 
     /// Number of unknowns.
@@ -482,6 +527,9 @@ impl Statics {
         if let Some(s) = state.as_deref_mut() {
             s.pin_force.resize(nd * zp, 0.0);
             s.pin_gap.resize(nd * zp, 0.0);
+            s.pin_location_moment.clear();
+            s.bearing_couple = 0.0;
+            s.pin_location_moment.resize(nd * zp, 0.0);
             s.pin_jet.clear();
             s.mesh_force.clear();
             s.mesh_deflection.clear();
@@ -551,17 +599,76 @@ impl Statics {
                 };
                 let pen = -jet.gap;
                 self.max_penetration = self.max_penetration.max(pen);
-                let (f, fp) = if on(Family::Pins(k)) {
-                    elastic(&self.pin_law, pen)
-                } else {
-                    (0.0, 0.0)
-                };
-                if let Some(c) = cf.as_mut()
-                    && on(Family::Pins(k))
-                {
-                    c.outer(&idx, &jet.grad, contact_damping(&self.pin_law, pen));
+                let mut f = 0.0;
+                let mut fp = 0.0;
+                if on(Family::Pins(k)) && pen > 0.0 {
+                    match &self.pin_law {
+                        PinLaw::Impact(l) => {
+                            (f, fp) = elastic(l, pen);
+                            if let Some(c) = cf.as_mut() {
+                                c.outer(&idx, &jet.grad, contact_damping(l, pen));
+                            }
+                        }
+                        PinLaw::Line {
+                            pin: pm,
+                            disc: dm,
+                            damping,
+                        } => {
+                            // Line contact: the force depends on the approach and on where
+                            // the pin touches (K0(phi)); V = U(pen, phi(x)),
+                            // Q = F grad g - U_phi grad phi,
+                            // K = k_t gg^T - U_dphi (g phi^T + phi g^T) + U_phiphi phi phi^T
+                            //     - F hess g + U_phi hess phi (docs/model.md).
+                            // The curve's derivatives at the contact, once for both jets.
+                            let cd = centre_curve_derivatives_cs(&d.geometry, jet.phi_cos_sin);
+                            let lj = line_jet_with(
+                                &d.geometry,
+                                &cd,
+                                pen,
+                                pin.radius,
+                                d.body_depth,
+                                pm,
+                                dm,
+                                self.ln_warm[slot],
+                            )?;
+                            self.ln_warm[slot] = lj.ln_force;
+                            let fj = foot_jet_with(&d.geometry, pin.centre, o, cs, &cd)
+                                .ok_or_else(|| {
+                                    RvdynError::Convergence(format!(
+                                        "pin {} on disc {k}: no unique contact point on the \
+                                         profile (the disc is far from any sensible pose)",
+                                        j + 1
+                                    ))
+                                })?;
+                            f = lj.force;
+                            let u_phi = lj.energy_per_phi();
+                            for a in 0..3 {
+                                qf[idx[a]] += f * jet.grad[a] - u_phi * fj.grad[a];
+                            }
+                            if let Some(s) = state.as_deref_mut() {
+                                let q = [-u_phi * fj.grad[0], -u_phi * fj.grad[1]];
+                                s.pin_location_moment[slot] =
+                                    o[0] * q[1] - o[1] * q[0] - u_phi * fj.grad[2];
+                            }
+                            kf.outer(&idx, &jet.grad, lj.stiffness);
+                            kf.outer_sym(&idx, &jet.grad, &fj.grad, -lj.cross());
+                            kf.outer(&idx, &fj.grad, lj.phi_phi());
+                            for a in 0..3 {
+                                for b in 0..3 {
+                                    kf.add(
+                                        idx[a],
+                                        idx[b],
+                                        -f * jet.hess[a][b] + u_phi * fj.hess[a][b],
+                                    );
+                                }
+                            }
+                            if let Some(c) = cf.as_mut() {
+                                c.outer(&idx, &jet.grad, damping.rate_coefficient(f, lj.stiffness));
+                            }
+                        }
+                    }
                 }
-                if f > 0.0 || fp > 0.0 {
+                if matches!(self.pin_law, PinLaw::Impact(_)) && (f > 0.0 || fp > 0.0) {
                     for a in 0..3 {
                         qf[idx[a]] += f * jet.grad[a];
                     }
@@ -599,6 +706,8 @@ impl Statics {
                 let rot = rbs * (x[SUN] - thc) + rbp * (alpha - thc);
                 let half = 0.5 * mm.backlash;
                 let idx = [SUN, CARRIER, ci + 2, ci, ci + 1];
+                // Mesh position along the line of action (the dynamic models' `s`).
+                let s_mesh = rbs * (x[SUN] - thc) + mm.phases[i] * mm.base_pitch;
                 let mut f_report = 0.0;
                 for sigma in [1.0, -1.0] {
                     let w = [
@@ -608,11 +717,14 @@ impl Statics {
                     let zw = perp(w);
                     let pen = sigma * rot - dot(dcr, w) - half;
                     self.max_penetration = self.max_penetration.max(pen);
-                    let (f, fp) = if on(Family::Mesh) {
-                        elastic(&self.mesh_law, pen)
+                    // V = k(s') pen^2 / 2 for the ISO wave at the flank's position
+                    // s' = sigma s: force, stiffness, V_s, V_pen,s, V_ss, damping coefficient.
+                    let ms = if on(Family::Mesh) {
+                        mesh_static(&mm.law, pen, sigma * s_mesh)
                     } else {
-                        (0.0, 0.0)
+                        MeshStatic::default()
                     };
+                    let (f, fp) = (ms.force, ms.stiffness);
                     let grad = [
                         sigma * rbs,
                         -sigma * (rbs + rbp) + dot(perp(s), w) - dot(dcr, zw),
@@ -623,13 +735,18 @@ impl Statics {
                     if let Some(c) = cf.as_mut()
                         && on(Family::Mesh)
                     {
-                        c.outer(&idx, &grad, contact_damping(&self.mesh_law, pen));
+                        c.outer(&idx, &grad, ms.damping);
                     }
                     if f > 0.0 || fp > 0.0 {
+                        let gs = [sigma * rbs, -sigma * rbs, 0.0, 0.0, 0.0];
                         for a in 0..5 {
-                            qf[idx[a]] -= f * grad[a];
+                            qf[idx[a]] -= f * grad[a] + ms.v_s * gs[a];
                         }
                         kf.outer(&idx, &grad, fp);
+                        if ms.v_ps != 0.0 || ms.v_ss != 0.0 {
+                            kf.outer_sym(&idx, &grad, &gs, ms.v_ps);
+                            kf.outer(&idx, &gs, ms.v_ss);
+                        }
                         kf.add(CARRIER, CARRIER, f * dot(p, w));
                         kf.sym(CARRIER, ci, -f * zw[0]);
                         kf.sym(CARRIER, ci + 1, -f * zw[1]);
@@ -663,6 +780,7 @@ impl Statics {
                 kf.add(CARRIER, CARRIER, dot(g, s));
                 if let Some(st) = state.as_deref_mut() {
                     st.crank_bearing_force.push([-g[0], -g[1]]);
+                    st.bearing_couple -= dcr[0] * g[1] - dcr[1] * g[0];
                 }
             }
             // Eccentric bearings (i, k): d = O_k + R(theta_k) h_ik - p_i - eps_ik(alpha_i).
@@ -701,6 +819,7 @@ impl Statics {
                     kf.add(ci + 2, ci + 2, dot(g, ecc));
                     if let Some(st) = state.as_deref_mut() {
                         st.eccentric_bearing_force.push([-g[0], -g[1]]);
+                        st.bearing_couple -= d[0] * g[1] - d[1] * g[0];
                     }
                 }
             }
@@ -902,6 +1021,50 @@ pub fn elastic(law: &ImpactLaw, pen: f64) -> (f64, f64) {
     ContactLaw::Impact(*law).elastic_force_and_stiffness(pen)
 }
 
+/// A mesh flank's static law at one pose: `V(pen, s)` and its derivatives.
+#[derive(Debug, Clone, Copy, Default)]
+struct MeshStatic {
+    force: f64,
+    stiffness: f64,
+    v_s: f64,
+    v_ps: f64,
+    v_ss: f64,
+    damping: f64,
+}
+
+/// The static law of a mesh flank at penetration `pen` [m] and mesh position `s` [m]: IMPACT
+/// (no dependence on `s`) or the ISO 6336 wave, `V = k(s) pen^2 / 2`: `F = k pen`,
+/// `V_s = k' pen^2 / 2`, `V_pen,s = k' pen`, `V_ss = k'' pen^2 / 2`.
+#[inline]
+fn mesh_static(law: &MeshLaw, pen: f64, s: f64) -> MeshStatic {
+    if pen <= 0.0 {
+        return MeshStatic::default();
+    }
+    match law {
+        MeshLaw::Impact(l) => {
+            let (force, stiffness) = elastic(l, pen);
+            MeshStatic {
+                force,
+                stiffness,
+                damping: contact_damping(l, pen),
+                ..MeshStatic::default()
+            }
+        }
+        MeshLaw::Iso(m) => {
+            let (k, dk, d2k) = m.wave.stiffness_slope_curvature(s);
+            let force = k * pen;
+            MeshStatic {
+                force,
+                stiffness: k,
+                v_s: 0.5 * dk * pen * pen,
+                v_ps: dk * pen,
+                v_ss: 0.5 * d2k * pen * pen,
+                damping: m.damping.rate_coefficient(force, k),
+            }
+        }
+    }
+}
+
 /// Damping coefficient [N s/m] of an IMPACT law at penetration `pen` [m] (at zero rate).
 #[inline]
 pub fn contact_damping(law: &ImpactLaw, pen: f64) -> f64 {
@@ -993,6 +1156,29 @@ mod tests {
         let mut single_c = single;
         single_c.joints = crate::dynamics::compliant::default_joints();
         out.push(single_c);
+        out.extend(physical_scenes());
+        out
+    }
+
+    /// The physical preset (line law, ISO mesh, roller bearings with clearance), modified,
+    /// with rigid crank bearings, and with rigid joints.
+    fn physical_scenes() -> Vec<Scene> {
+        let mut out = Vec::new();
+        let base = Scene::physical("rated").unwrap();
+        out.push(base.clone());
+        let mut m = base.clone();
+        m.cycloid.d_rrp = 2e-5;
+        m.cycloid.d_rp = -2e-5;
+        m.stage1.as_mut().unwrap().backlash = 2e-5;
+        out.push(m.clone());
+        let mut c = m.clone();
+        if let Joints::Compliant { crank_bearing, .. } = &mut c.joints {
+            *crank_bearing = None;
+        }
+        out.push(c);
+        let mut r = m;
+        r.joints = Joints::Rigid;
+        out.push(r);
         out
     }
 
@@ -1256,6 +1442,74 @@ mod tests {
                 }
             }
             assert!(worst < 1e-6, "{:?}: K vs FD {worst:e}", scene.joints);
+        }
+    }
+
+    /// The roller bearings' analytic static tangent and damping matrix against central
+    /// differences of their force (`BearingLaw::load`): in the deflection (step 1e-10 m) and
+    /// in the rate (step 1e-6 m/s; the damping is linear in the rate, so exact to round-off).
+    /// Deflections where a roller is within 1e-7 m of first touch are skipped: there the
+    /// difference of `Q = K delta^(10/9)` errs by `0.0165 h^2 / delta^2` (relative), below 2e-8
+    /// elsewhere; round-off ~1e-16 F / h ~ 1e-7 of the stiffness. Asserted 1e-6 of the
+    /// largest entry.
+    #[test]
+    fn roller_bearing_tangent_matches_finite_differences() {
+        let scene = Scene::physical("rated").unwrap();
+        let Joints::Compliant {
+            eccentric_bearing,
+            crank_bearing,
+        } = &scene.joints
+        else {
+            panic!("physical joints are compliant")
+        };
+        let mut rnd = rng(41);
+        for spec in [eccentric_bearing, crank_bearing.as_ref().unwrap()] {
+            let law = BearingLaw::new(spec).unwrap();
+            let BearingLaw::Rollers { bearing, .. } = &law else {
+                panic!("rollers expected")
+            };
+            let z = bearing.rollers();
+            let mut tested = 0;
+            while tested < 30 {
+                let d = [3e-5 * rnd(), 3e-5 * rnd()];
+                let near = (0..z).any(|j| {
+                    let a = TAU * j as f64 / z as f64;
+                    (d[0] * a.cos() + d[1] * a.sin() - bearing.clearance()).abs() < 1e-7
+                });
+                if near || d[0].hypot(d[1]) < bearing.clearance() + 2e-6 {
+                    continue;
+                }
+                tested += 1;
+                let (g, h) = law.static_tangent(d);
+                let c = law.damping_matrix(d);
+                let f0 = law.load(d, [0.0; 2]).force;
+                assert_eq!(g, [-f0[0], -f0[1]]);
+                let hmax = h.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+                let cmax = c.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+                for k in 0..2 {
+                    let (mut a, mut b) = (d, d);
+                    a[k] += 1e-10;
+                    b[k] -= 1e-10;
+                    let (fa, fb) = (law.load(a, [0.0; 2]).force, law.load(b, [0.0; 2]).force);
+                    let mut va = [0.0; 2];
+                    va[k] = 1e-6;
+                    let (ra, rb) = (law.load(d, va).force, law.load(d, [-va[0], -va[1]]).force);
+                    for r in 0..2 {
+                        let fd = -(fa[r] - fb[r]) / 2e-10;
+                        assert!(
+                            (fd - h[r][k]).abs() < 1e-6 * hmax,
+                            "K {r}{k}: {fd} {}",
+                            h[r][k]
+                        );
+                        let fdc = -(ra[r] - rb[r]) / 2e-6;
+                        assert!(
+                            (fdc - c[r][k]).abs() < 1e-6 * cmax,
+                            "C {r}{k}: {fdc} {}",
+                            c[r][k]
+                        );
+                    }
+                }
+            }
         }
     }
 }

@@ -443,3 +443,108 @@ fn cpu_time_report() {
         lp * 1e3
     );
 }
+
+/// Errors the statics do not model are refused with a `SceneError` naming them (the LTCA does
+/// not silently analyse the error-free reducer instead).
+#[test]
+fn unsupported_errors_are_named() {
+    use crate::dynamics::scene::ProfileError;
+    let base = Scene::physical("rated").unwrap();
+    let mut profile = base.clone();
+    profile.discs[0].profile_error = Some(ProfileError {
+        harmonics: vec![[1e-6, 3.0, 0.0]],
+        table: vec![],
+    });
+    let mut gear = base.clone();
+    gear.gear_errors.sun.runout = 1e-6;
+    let mut assembly = base.clone();
+    assembly.errors.crank_eccentricity = vec![1e-6, 0.0, 0.0];
+    for (s, what) in [
+        (profile, "profile_error"),
+        (gear, "gear_errors"),
+        (assembly, "crank eccentricity"),
+    ] {
+        match Ltca::new(&s) {
+            Err(RvdynError::Scene(m)) => assert!(m.contains(what), "{m}"),
+            other => panic!("{what}: expected a SceneError, got {:?}", other.err()),
+        }
+    }
+    assert!(Ltca::new(&base).is_ok());
+}
+
+/// The line law blends the disc's reference depth across `kappa_P D = 1` (docs/model.md, "Pin
+/// against cycloid disc"). Before the blend, a loaded contact crossing that point (physical
+/// preset, `d_rp = -20 um`, crank angle 2.3082 rad) made the location force jump and Newton
+/// found no equilibrium there. Now it solves, and the pin forces across it change smoothly:
+/// over 2e-4 rad centred on the crossing, the largest pin-force change between neighbouring
+/// angles 2e-5 rad apart stays within 3 times the mean change per step (a jump of the old
+/// kind was 20 times it).
+#[test]
+fn pin_forces_are_smooth_across_the_depth_blend() {
+    let mut s = Scene::physical("rated").unwrap();
+    s.cycloid.d_rp = -2e-5;
+    let mut ltca = Ltca::new(&s).unwrap();
+    let psi0 = 2.308_197_935_762_501;
+    let forces: Vec<Vec<f64>> = (-5..=5)
+        .map(|i| {
+            let p = ltca.solve(rated(), psi0 + 2e-5 * i as f64).unwrap();
+            p.pins.iter().flatten().map(|l| l.force).collect()
+        })
+        .collect();
+    let steps: Vec<f64> = forces
+        .windows(2)
+        .map(|w| {
+            w[0].iter()
+                .zip(&w[1])
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    let mean = steps.iter().sum::<f64>() / steps.len() as f64;
+    let worst = steps.iter().cloned().fold(0.0, f64::max);
+    assert!(mean > 0.0 && worst < 3.0 * mean, "steps {steps:?}");
+}
+
+/// A torque-twist loop whose zero-torque point Newton cannot reach from the kinematic pose
+/// (physical preset with pin radius errors and modifications, sample 428 of the 10 000-sample
+/// study in BENCHMARKS.md 13.1: the bodies float in the bearing clearances, some pins are
+/// preloaded) is completed by continuation from 1e-2 rated; its catalogue figures are finite
+/// and ordered.
+#[test]
+fn zero_torque_limit_by_continuation() {
+    let mut s = Scene::physical("rated").unwrap();
+    s.cycloid.d_rrp = -2.564_952_275_363_655e-7;
+    s.cycloid.d_rp = -2.826_951_413_145_57e-6;
+    s.pin_errors.radius = vec![
+        -1.112_599_373_492_489_8e-6,
+        -1.768_539_243_792_398_7e-6,
+        -4.777_438_123_914_611_5e-6,
+        4.882_652_362_319_679e-6,
+        3.248_265_596_608_798e-7,
+        7.882_658_047_440_166e-7,
+        7.256_710_737_919_903e-8,
+        4.080_799_420_314_174e-6,
+        1.120_731_849_109_812_7e-6,
+        -1.091_075_135_946_992_7e-6,
+        -2.217_840_467_851_037e-6,
+        -2.972_824_126_105_944e-6,
+        1.220_949_778_776_095_2e-6,
+        4.023_083_627_160_912e-6,
+        3.308_289_345_363_807_4e-6,
+        -4.250_067_239_665_637e-6,
+        4.638_259_778_539_203e-6,
+        1.629_894_266_273_321e-6,
+        -2.161_710_383_519_091e-6,
+        -1.177_098_475_687_473e-6,
+        1.468_255_901_030_791_3e-6,
+        2.079_780_955_800_177_2e-6,
+        -3.084_438_091_951_610_5e-6,
+        -2.806_222_544_910_242e-6,
+    ];
+    // (Without the continuation this loop fails: Newton from the kinematic pose at 1e-7
+    // rated stalls after 200 iterations.)
+    let mut ltca = Ltca::new(&s).unwrap();
+    let lp = ltca.twist_loop(rated(), 0.0, 41).unwrap();
+    assert!(lp.rigidity > 0.0 && lp.backlash >= 0.0 && lp.lost_motion > lp.backlash);
+    assert!(lp.twist.iter().all(|v| v.is_finite()));
+}

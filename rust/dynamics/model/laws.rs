@@ -172,23 +172,24 @@ impl BearingLaw {
     #[inline]
     pub fn static_tangent(&self, d: [f64; 2]) -> ([f64; 2], [[f64; 2]; 2]) {
         match self {
-            BearingLaw::Rollers { .. } => {
-                // Central differences of the force at zero rate (step 1 nm; the roller law is
-                // smooth away from each roller's first contact).
-                let f = |x: [f64; 2]| self.load(x, [0.0; 2]).force;
-                let f0 = f(d);
-                let h = 1e-9;
-                let mut hess = [[0.0; 2]; 2];
-                for c in 0..2 {
-                    let (mut a, mut b) = (d, d);
-                    a[c] += h;
-                    b[c] -= h;
-                    let (fa, fb) = (f(a), f(b));
-                    for (r, row) in hess.iter_mut().enumerate() {
-                        row[c] = -(fa[r] - fb[r]) / (2.0 * h);
+            BearingLaw::Rollers {
+                bearing, parallel, ..
+            } => {
+                // Each roller j is compressed by delta_j = d . n_j - c along its fixed
+                // direction n_j, linear in d: hess V = sum_j Q_j'(delta_j) n_j n_j^T, no
+                // geometric term (Harris & Kotzalas 2007, ch. 7; docs/model.md).
+                let st = bearing.state(d, 0.0);
+                let (mut g, mut h) = ([-st.force[0], -st.force[1]], st.stiffness);
+                if parallel.stiffness > 0.0 {
+                    let (gl, hl) = BearingLaw::Linear(*parallel).static_tangent(d);
+                    for a in 0..2 {
+                        g[a] += gl[a];
+                        for c in 0..2 {
+                            h[a][c] += hl[a][c];
+                        }
                     }
                 }
-                ([-f0[0], -f0[1]], hess)
+                (g, h)
             }
             BearingLaw::Linear(b) => {
                 if b.clearance <= 0.0 {
@@ -220,16 +221,26 @@ impl BearingLaw {
     #[inline]
     pub fn damping_matrix(&self, d: [f64; 2]) -> [[f64; 2]; 2] {
         match self {
-            BearingLaw::Rollers { .. } => {
-                let h = 1e-6;
+            BearingLaw::Rollers {
+                bearing,
+                beta,
+                parallel,
+            } => {
+                // Roller j damps with beta Q_j' along n_j: C = beta K (stiffness-proportional
+                // per roller, `RollerBearing::damped_force`).
+                let k = bearing.state(d, 0.0).stiffness;
                 let mut c = [[0.0; 2]; 2];
-                for k in 0..2 {
-                    let (mut a, mut b) = ([0.0; 2], [0.0; 2]);
-                    a[k] = h;
-                    b[k] = -h;
-                    let (fa, fb) = (self.load(d, a).force, self.load(d, b).force);
-                    for (r, row) in c.iter_mut().enumerate() {
-                        row[k] = -(fa[r] - fb[r]) / (2.0 * h);
+                for a in 0..2 {
+                    for b in 0..2 {
+                        c[a][b] = beta * k[a][b];
+                    }
+                }
+                if parallel.damping > 0.0 {
+                    let cl = BearingLaw::Linear(*parallel).damping_matrix(d);
+                    for a in 0..2 {
+                        for b in 0..2 {
+                            c[a][b] += cl[a][b];
+                        }
                     }
                 }
                 c
