@@ -248,11 +248,7 @@ impl LineContactLaw {
             geometry.centre_curve_curvature(phi),
             geometry.generating_pin_radius(),
         )?;
-        let h2 = if kappa * disc_depth > 1.0 {
-            1.0 / kappa
-        } else {
-            disc_depth
-        };
+        let h2 = disc_reference_depth(kappa, disc_depth).depth;
         Self::from_checked(
             geometry.params().face_width,
             1.0 / pin_radius,

@@ -286,3 +286,62 @@ pub(crate) fn pin_law_force(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::hertz::Material;
+    use crate::contact::law::{ContactDamping, DampingSpec};
+    use crate::geometry::CycloidGeometry;
+    use crate::geometry::cycloid::CycloidParams;
+
+    /// The models' line law (checked once, inversion warm-started from the pin's last `ln F`)
+    /// gives the force of the fully checked `PinLaw::evaluate` to 1e-14 relative, from any
+    /// earlier force (none, far below, far above, the previous one), over the profile and from
+    /// 1e-9 m to 1e-4 m of approach.
+    #[test]
+    fn warm_started_line_law_gives_the_checked_force() {
+        let g = CycloidGeometry::new(CycloidParams::paper()).unwrap();
+        let s = Material::steel();
+        let damping = ContactDamping::new(&DampingSpec::DampingRatio {
+            ratio: 0.05,
+            frequency: 1000.0,
+        })
+        .unwrap();
+        let law = PinLaw::Line {
+            pin: s,
+            disc: s,
+            damping,
+        };
+        let warm = Cell::new(WarmStart::default());
+        for i in 0..40 {
+            let phi = 0.2 * i as f64 / 23.0;
+            let site = PinSite {
+                geometry: &g,
+                phi,
+                pin_radius: 0.010,
+                depth: 0.14,
+            };
+            for pen in [1e-9, 3e-7, 2.59e-5, 1e-4] {
+                let want = law.evaluate(pen, 1e-3, &site, true).unwrap();
+                for guess in [f64::NAN, 0.0, 30.0, warm.get().ln_force] {
+                    let mut w = warm.get();
+                    w.ln_force = guess;
+                    warm.set(w);
+                    let got = pin_law_force(&law, pen, 1e-3, &site, true, &warm).unwrap();
+                    for (a, b) in [
+                        (got.force, want.force),
+                        (got.elastic, want.elastic),
+                        (got.energy, want.energy),
+                    ] {
+                        assert!(
+                            (a - b).abs() <= 1e-14 * b.abs(),
+                            "{phi} {pen} {guess}: {a} {b}"
+                        );
+                    }
+                    assert!((warm.get().ln_force - want.elastic.ln()).abs() < 1e-13);
+                }
+            }
+        }
+    }
+}
