@@ -5,11 +5,16 @@
 //! cargo build --release --example count_work
 //! valgrind --tool=callgrind target/release/examples/count_work run 0.02 generalized-alpha rigid
 //! valgrind --tool=callgrind target/release/examples/count_work rhs 20000   # minus `rhs 0`
+//! valgrind --tool=callgrind target/release/examples/count_work phys 20000  # minus `phys 0`
 //! ```
 //!
-//! `run T METHOD JOINTS`: `dynamics::simulate` of the rated default scene for T s with no
-//! channels recorded (JOINTS `rigid` or `compliant`); `rhs N`: N force evaluations of the
-//! rigid rated scene at one loaded state (after 0.05 s from rest).
+//! `run T METHOD JOINTS [record|-] [ATOL RTOL]`: `dynamics::simulate` of the rated default
+//! scene for T s with no channels recorded (JOINTS `rigid`, `compliant`, or `physical` for the
+//! physical preset), or with `record` the default channels at every step; `rhs N`: N force evaluations of the
+//! rigid rated scene at one loaded state (after 0.05 s from rest); `phys N`: N force evaluations of
+//! the physical rated preset (compliant roller bearings) at one loaded state (after 0.1 s from
+//! rest).
+use rvdyn::dynamics::compliant::CompliantModel;
 use rvdyn::dynamics::model::ReducerModel;
 use rvdyn::dynamics::system::RigidSystem;
 use rvdyn::dynamics::{RigidModel, RunControl, Scene, SimOptions, simulate};
@@ -21,6 +26,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let arg = |i: usize, default: &str| args.get(i).cloned().unwrap_or_else(|| default.into());
     let mut scene = Scene::paper("rated")?;
+    if arg(1, "run") == "phys" {
+        let n: usize = arg(2, "20000").parse()?;
+        let model = CompliantModel::new(&Scene::physical("rated")?)?;
+        let (q, v) = model.initial_state();
+        let mut st = State::new(&model, 0.0, q, v)?;
+        let mut ga = GeneralizedAlpha::new(0.8, 1e-9, false)?;
+        for _ in 0..5000 {
+            ga.step(&model, &mut st, 2e-5)?;
+        }
+        let a = eval_loop(&model, &st, n)?;
+        println!("{n} evaluations, a = {a:?}");
+        return Ok(());
+    }
     if arg(1, "run") == "rhs" {
         let n: usize = arg(2, "20000").parse()?;
         let model = RigidModel::new(&scene)?;
@@ -46,12 +64,40 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let t_end: f64 = arg(2, "0.02").parse()?;
     let method = Method::parse(&arg(3, "generalized-alpha"))?;
+    if arg(4, "rigid") == "physical" {
+        scene = Scene::physical("rated")?;
+    }
     if arg(4, "rigid") == "compliant" {
         scene.joints = rvdyn::dynamics::compliant::default_joints();
     }
     let mut opt = SimOptions::new(t_end, method);
-    opt.channels = vec![];
+    if let (Ok(atol), Ok(rtol)) = (arg(6, "").parse::<f64>(), arg(7, "").parse::<f64>()) {
+        (opt.atol, opt.rtol) = (atol, rtol);
+    }
+    if arg(5, "") == "record" {
+        // The default channels at every step (record interval = the step).
+        opt.record_interval = Some(SimOptions::default_dt(method));
+    } else {
+        opt.channels = vec![];
+    }
     let r = simulate(&scene, &opt, &RunControl::default())?;
     println!("{} samples, stats {:?}", r.samples, r.stats);
     Ok(())
+}
+
+/// `n` evaluations of `sys` at `st` (kept out of line so that a profiler can collect this
+/// function alone: `--toggle-collect='*eval_loop*'`).
+#[inline(never)]
+fn eval_loop<S: MechanicalSystem>(sys: &S, st: &State, n: usize) -> rvdyn::Result<Vec<f64>> {
+    let (mut a, mut p) = (vec![0.0; sys.dof()], [0.0; 3]);
+    for _ in 0..n {
+        sys.eval(
+            black_box(st.t),
+            black_box(&st.q),
+            black_box(&st.v),
+            &mut a,
+            &mut p,
+        )?;
+    }
+    Ok(a)
 }

@@ -129,12 +129,12 @@ def test_bad_shafts_are_scene_errors_naming_the_field(changes: dict[str, object]
 
 
 @pytest.mark.parametrize("joints", ["rigid", "compliant"])
-def test_modal_analysis_of_a_scene_with_shafts_is_a_scene_error(joints: str) -> None:
-    # The modal analysis models the reducer alone so far: a scene with shafts is refused with a
-    # SceneError naming the fields (not a crash).
+def test_modal_analysis_of_a_scene_with_shafts_models_them(joints: str) -> None:
+    # The modal analysis adds the shafts' coordinates (tests/test_modal_shafts.py checks the
+    # frequencies): the load angle with an output shaft, the sun angle with a drive shaft.
     from rvdyn.analysis import modes
 
-    for shaft in ({"inertias.load_inertia": 5.0, "shafts.output": {"stiffness": 1e6}},
-                  {"inertias.motor_inertia": 0.01, "shafts.input": {"stiffness": 1e4}}):
-        with pytest.raises(SceneError, match=r"shafts\.output / shafts\.input"):
-            modes.modes(_with(RATED.replace(**shaft), joints))
+    for shaft, name in (({"inertias.load_inertia": 5.0, "shafts.output": {"stiffness": 1e6}}, "load angle"),
+                        ({"inertias.motor_inertia": 0.01, "shafts.input": {"stiffness": 1e4}}, "sun angle")):
+        m = modes.modes(_with(RATED.replace(**shaft), joints))
+        assert m.dof_names[-1] == name and m.part_names[-1] == "shafts"

@@ -21,8 +21,9 @@ study
     Tolerance studies (Monte Carlo / Latin hypercube, threads / processes / Dask / Ray).
 order_spectrum, excitation_orders
     Order spectrum of a recorded channel, labelled with the reducer's excitation orders.
-modes, modes_over_mesh, campbell
-    Modes about the loaded equilibrium (energy shares per contact/bearing family), over a
+modes, modes_at, modes_over_mesh, campbell
+    Modes about the loaded equilibrium or a dynamic run's state (energy shares per
+    contact/bearing/shaft family), over a
     mesh period, and the Campbell diagram over input speed.
 rvdyn.plotting
     Matplotlib figures (geometry, contact stiffness).
@@ -53,7 +54,7 @@ from ._core import (
 )
 from ._types import GapResult, LineContact, OperatingPoint
 from .analysis.campbell import campbell
-from .analysis.modes import modes, modes_over_mesh
+from .analysis.modes import modes, modes_at, modes_over_mesh
 from .analysis.spectrum import excitation_orders, order_spectrum
 from .result import Result
 from .scene import Scene
@@ -84,6 +85,7 @@ __all__ = [
     "order_spectrum",
     "excitation_orders",
     "modes",
+    "modes_at",
     "modes_over_mesh",
     "campbell",
     "CycloidGeometry",

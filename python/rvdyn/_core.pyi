@@ -44,6 +44,8 @@ __all__ = [
     "excitation_orders",
     "campbell_crossings",
     "modes",
+    "modes_state",
+    "rigid_coordinates",
     "campbell_diagram",
 ]
 
@@ -501,6 +503,12 @@ def campbell_crossings(
 
 def modes(scene_json: str, torque: float, crank_angles: list[float]) -> list[dict[str, Any]]:
     """Modes about the equilibrium at each crank angle [rad] under the output torque [N m]."""
+
+def modes_state(scene_json: str, t: float, q: list[float], v: list[float]) -> dict[str, Any]:
+    """Modes about the state (q [rad, m], v [rad/s, m/s]) at time t [s] of a dynamic run."""
+
+def rigid_coordinates(scene_json: str) -> list[int] | None:
+    """The rigid model's free coordinates in [carrier, crank, sun, load, motor]; None if compliant."""
 
 def campbell_diagram(
     scene_json: str,

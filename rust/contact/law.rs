@@ -194,6 +194,49 @@ impl PinLaw {
         }
     }
 
+    /// As [`PinLaw::evaluate`] for a law and site built by a model from a validated scene
+    /// (materials, pin radius and depth checked once), with the line law's Newton inversion
+    /// started from `ln_force_guess` (`ln F` of this contact at the previous evaluation, or NaN):
+    /// the same force to round-off (the inversion converges to 1e-15, see
+    /// [`LineContactLaw::force_and_stiffness_from`]), in fewer iterations. Returns the force and
+    /// `ln F` to keep as the next guess (NaN for IMPACT).
+    #[inline]
+    pub(crate) fn evaluate_warm(
+        &self,
+        pen: f64,
+        rate: f64,
+        site: &PinSite<'_>,
+        want_energy: bool,
+        ln_force_guess: f64,
+    ) -> Result<(LawForce, f64)> {
+        match self {
+            PinLaw::Impact(_) => Ok((self.evaluate(pen, rate, site, want_energy)?, f64::NAN)),
+            PinLaw::Line { pin, disc, damping } => {
+                let law = LineContactLaw::cycloid_contact_checked(
+                    site.geometry,
+                    site.phi,
+                    site.pin_radius,
+                    site.depth,
+                    pin,
+                    disc,
+                )?;
+                let (fe, k, ln_f) = law.force_and_stiffness_from(pen, ln_force_guess);
+                Ok((
+                    LawForce {
+                        force: damping.force(fe, k, rate),
+                        elastic: fe,
+                        energy: if want_energy {
+                            law.elastic_energy(pen)
+                        } else {
+                            0.0
+                        },
+                    },
+                    ln_f,
+                ))
+            }
+        }
+    }
+
     /// The line law's energy depends on where the pin touches the profile (the curvature
     /// sets `K0`, see `contact::line_contact`), so a conservative force field needs, besides
     /// the normal force, the term `-dU/dphi dphi/dq`. With `delta = F (K0 - K1 ln F)`,
@@ -213,6 +256,20 @@ impl PinLaw {
         disc_centre: [f64; 2],
         disc_angle: f64,
     ) -> Option<LocationSlope> {
+        self.location_slope_at(elastic, site, pin_centre, disc_centre, disc_angle.sin_cos())
+    }
+
+    /// As [`PinLaw::location_slope`] with the disc angle given by its sine and cosine (a model
+    /// has them per disc already).
+    #[inline]
+    pub(crate) fn location_slope_at(
+        &self,
+        elastic: f64,
+        site: &PinSite<'_>,
+        pin_centre: [f64; 2],
+        disc_centre: [f64; 2],
+        (sn, cs): (f64, f64),
+    ) -> Option<LocationSlope> {
         let PinLaw::Line { pin, disc, .. } = self else {
             return None;
         };
@@ -221,7 +278,14 @@ impl PinLaw {
         }
         let g = site.geometry;
         let r = g.generating_pin_radius();
-        let kc = g.centre_curve_curvature(site.phi);
+        // The curve's jet at the contact, used twice: the curvature (as
+        // `CycloidGeometry::centre_curve_curvature`) and the foot sensitivity below.
+        let j = g.jet(site.phi);
+        let kc = {
+            let cross = j.d1[0] * j.d2[1] - j.d1[1] * j.d2[0];
+            let len = j.d1[0].hypot(j.d1[1]);
+            cross / (len * len * len)
+        };
         let h = 1e-6;
         let dkc = (g.centre_curve_curvature(site.phi + h) - g.centre_curve_curvature(site.phi - h))
             / (2.0 * h);
@@ -236,13 +300,11 @@ impl PinLaw {
         let dk0 = (2.0 * c2 * dln_h2 - (c1 + c2) * dln_r) / (std::f64::consts::PI * length);
         let energy_per_phi = -0.5 * elastic * elastic * dk0;
         // Foot sensitivity in the (unrotated) disc frame.
-        let (sn, cs) = disc_angle.sin_cos();
         let d = [
             pin_centre[0] - disc_centre[0],
             pin_centre[1] - disc_centre[1],
         ];
         let p = g.remove_rotation_mod([cs * d[0] + sn * d[1], -sn * d[0] + cs * d[1]]);
-        let j = g.jet(site.phi);
         let gp = j.d1[0] * j.d1[0]
             + j.d1[1] * j.d1[1]
             + (j.c[0] - p[0]) * j.d2[0]

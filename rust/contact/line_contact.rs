@@ -104,6 +104,22 @@ impl LineContactLaw {
         }
         m1.validate()?;
         m2.validate()?;
+        Self::from_checked(length, curvature1, curvature2, depth1, depth2, m1, m2)
+    }
+
+    /// [`LineContactLaw::new`] without the checks of the length, depths, curvatures and
+    /// materials (the caller has validated them once, e.g. at scene build): the same arithmetic
+    /// and the same `Geometry` error for a non-positive curvature sum.
+    #[inline]
+    pub(crate) fn from_checked(
+        length: f64,
+        curvature1: f64,
+        curvature2: f64,
+        depth1: f64,
+        depth2: f64,
+        m1: &Material,
+        m2: &Material,
+    ) -> Result<Self> {
         let sum = curvature1 + curvature2;
         if !(sum > 0.0 && sum.is_finite()) {
             return Err(RvdynError::Geometry(format!(
@@ -208,15 +224,37 @@ impl LineContactLaw {
         pin: &Material,
         disc: &Material,
     ) -> Result<Self> {
+        require_positive("pin radius", pin_radius, "m")?;
+        require_positive("disc reference depth", disc_depth, "m")?;
+        pin.validate()?;
+        disc.validate()?;
+        Self::cycloid_contact_checked(geometry, phi, pin_radius, disc_depth, pin, disc)
+    }
+
+    /// [`LineContactLaw::cycloid_contact`] for a positive finite pin radius and disc depth and
+    /// valid materials (checked once by the caller): the same law, without re-checking them
+    /// at every contact evaluation. Errors (`Geometry`) as [`pin_disc_profile_curvature`] and
+    /// for a non-positive curvature sum.
+    #[inline]
+    pub(crate) fn cycloid_contact_checked(
+        geometry: &crate::geometry::CycloidGeometry,
+        phi: f64,
+        pin_radius: f64,
+        disc_depth: f64,
+        pin: &Material,
+        disc: &Material,
+    ) -> Result<Self> {
         let kappa = pin_disc_profile_curvature(
             geometry.centre_curve_curvature(phi),
             geometry.generating_pin_radius(),
         )?;
-        Self::pin_disc(
-            pin_radius,
-            kappa,
-            disc_depth,
+        let h2 = disc_reference_depth(kappa, disc_depth).depth;
+        Self::from_checked(
             geometry.params().face_width,
+            1.0 / pin_radius,
+            kappa,
+            pin_radius,
+            h2,
             pin,
             disc,
         )

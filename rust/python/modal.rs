@@ -2,7 +2,7 @@
 //! over crank angle, Campbell diagrams (`python/rvdyn/analysis/{spectrum,modes,campbell}.py`
 //! wrap these private functions).
 
-use crate::analysis::modal::{Linearizer, ModalPoint, campbell, modes_at};
+use crate::analysis::modal::{Linearizer, ModalPoint, campbell, modes_at, modes_at_state};
 use crate::analysis::orders::{ExcitationOrder, campbell_crossings, scene_orders};
 use crate::dynamics::scene::Scene;
 use numpy::IntoPyArray;
@@ -153,6 +153,8 @@ fn point_dict<'py>(py: Python<'py>, p: &ModalPoint) -> PyResult<Bound<'py, PyDic
     d.set_item("equilibrium", eq.unknowns.clone())?;
     d.set_item("residual", eq.residual)?;
     d.set_item("split_error", eq.split_error)?;
+    d.set_item("time", eq.time)?;
+    d.set_item("shaft_angles", eq.shaft_angles.to_vec())?;
     Ok(d)
 }
 
@@ -174,6 +176,40 @@ fn modes<'py>(
             .collect()
     })?;
     points.iter().map(|p| point_dict(py, p)).collect()
+}
+
+/// Modes of a scene about the state `(q, v)` at time `t` [s] of a dynamic run: `q`, `v` the
+/// run model's free coordinates [rad, m] and velocities [rad/s, m/s] (see `rvdyn.modes_at`).
+#[pyfunction]
+fn modes_state<'py>(
+    py: Python<'py>,
+    scene_json: &str,
+    t: f64,
+    q: Vec<f64>,
+    v: Vec<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let scene = Scene::from_json(scene_json)?;
+    let p = py.detach(|| -> crate::Result<ModalPoint> {
+        let mut lin = Linearizer::new(&scene)?;
+        modes_at_state(&mut lin, &scene, t, &q, &v)
+    })?;
+    point_dict(py, &p)
+}
+
+/// The rigid model's free coordinates as indices into `[carrier, crank, sun, load, motor]`
+/// (its `initial_state` order); `None` for compliant joints.
+#[pyfunction]
+fn rigid_coordinates(scene_json: &str) -> PyResult<Option<Vec<usize>>> {
+    let scene = Scene::from_json(scene_json)?;
+    if !matches!(scene.joints, crate::dynamics::scene::Joints::Rigid) {
+        return Ok(None);
+    }
+    let m = crate::dynamics::model::rigid::RigidModel::new(&scene)?;
+    Ok(Some(
+        crate::dynamics::model::rigid_system::RigidSystem::new(&m)
+            .coords
+            .clone(),
+    ))
 }
 
 /// Campbell diagram: natural frequencies over input speeds [rad/s] with the output torque at
@@ -243,6 +279,8 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(excitation_orders, m)?)?;
     m.add_function(wrap_pyfunction!(campbell_crossings_py, m)?)?;
     m.add_function(wrap_pyfunction!(modes, m)?)?;
+    m.add_function(wrap_pyfunction!(modes_state, m)?)?;
+    m.add_function(wrap_pyfunction!(rigid_coordinates, m)?)?;
     m.add_function(wrap_pyfunction!(campbell_diagram, m)?)?;
     Ok(())
 }

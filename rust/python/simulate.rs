@@ -427,6 +427,12 @@ fn to_python<'py>(
     stats.set_item("dt", rec.stats.dt)?;
     stats.set_item("wall_time", wall_time)?;
     stats.set_item("warnings", rec.warnings)?;
+    // The end state (free coordinates and velocities) for `rvdyn.modes_at`.
+    if let Some((t, q, v)) = rec.final_state {
+        stats.set_item("final_time", t)?;
+        stats.set_item("final_q", q)?;
+        stats.set_item("final_v", v)?;
+    }
     Ok((arrays, stats))
 }
 

@@ -18,7 +18,7 @@ import numpy as np
 from .. import _core
 from ..errors import ParameterError
 
-__all__ = ["Modes", "MeshSweep", "modes", "modes_over_mesh", "scene_torque"]
+__all__ = ["Modes", "MeshSweep", "modes", "modes_at", "modes_over_mesh", "scene_torque"]
 
 
 def _scene(scene: Any) -> Any:
@@ -60,7 +60,10 @@ class Modes:
     (``Im lambda / 2 pi``, 0 when overdamped); shape (modes, coordinates): scaled so that the
     largest displacement at the coordinate's lever is +1; energy_share (modes, parts): share
     of the strain energy in each stiffness family (rows sum to 1); mass, stiffness, damping:
-    the linearised matrices (SI: kg, kg m^2, N/m, N m/rad, N s/m ...)."""
+    the linearised matrices (SI: kg, kg m^2, N/m, N m/rad, N s/m ...). time [s]: the time of
+    the dynamic state linearised about (0 for an equilibrium); with machine shafts the
+    coordinates end with ``"sun angle"``, ``"load angle"``, ``"motor angle"`` and the parts
+    with ``"shafts"``; about a moving state the last part is ``"rate-dependent"``."""
 
     torque: float
     crank_angle: float
@@ -84,6 +87,7 @@ class Modes:
     split_error: float
     stiffness_asymmetry: float
     extra: dict[str, Any] = field(default_factory=dict)
+    time: float = 0.0
 
     @classmethod
     def _from_core(cls, d: dict[str, Any]) -> "Modes":
@@ -102,7 +106,8 @@ class Modes:
             residual=float(d["residual"]), split_error=float(d["split_error"]),
             stiffness_asymmetry=float(d["stiffness_asymmetry"]),
             extra={"equilibrium": list(d["equilibrium"]), "rigid_body": list(d["rigid_body"]),
-                   "unstable": list(d["unstable"])},
+                   "unstable": list(d["unstable"]), "shaft_angles": list(d["shaft_angles"])},
+            time=float(d["time"]),
         )
 
     def __len__(self) -> int:
@@ -164,18 +169,77 @@ class Modes:
         return ax
 
 
-def modes(scene: Any, torque: float | None = None, crank_angle: float = 0.0) -> Modes:
-    """Modes of ``scene`` (rigid or compliant joints) about its loaded quasi-static
-    equilibrium at ``crank_angle`` [rad] under the output torque ``torque`` [N m] (default:
-    the scene's constant load torque), input held.
+def modes(scene: Any, torque: float | None = None, crank_angle: float = 0.0, *,
+          state: tuple[float, Sequence[float], Sequence[float]] | None = None) -> Modes:
+    """Modes of ``scene`` (rigid or compliant joints, with or without machine shafts) about
+    its loaded quasi-static equilibrium at ``crank_angle`` [rad] under the output torque
+    ``torque`` [N m] (default: the scene's constant load torque), input held (the motor with a
+    drive shaft under a speed drive; free under a torque drive).
+
+    state: ``(t, q, v)`` of a dynamic run of this scene instead of an equilibrium: time [s],
+    the model's free coordinates [rad, m] and velocities [rad/s, m/s] in the order of the run
+    (``Result.stats["final_q"]``, see :func:`modes_at`); ``torque`` and ``crank_angle`` are
+    then not used. The pose is taken as it is; the stiffness gains a ``"rate-dependent"`` part
+    (the dynamic force's velocity terms), the damping matrix is taken at the state's speeds
+    (docs/model.md, "Linearisation about a dynamic state").
 
     Raises :class:`rvdyn.ConvergenceError` when there is no equilibrium (a torque the contacts
-    cannot carry), :class:`rvdyn.ParameterError` for non-finite input or a zero-inertia body
-    (naming its coordinate)."""
+    cannot carry), :class:`rvdyn.ParameterError` for non-finite input, a state of the wrong
+    length or a zero-inertia body (naming its coordinate)."""
     scene = _scene(scene)
+    if state is not None:
+        try:
+            t_s, q, v = state
+        except (TypeError, ValueError):
+            raise ParameterError("state must be a (t, q, v) triple") from None
+        return Modes._from_core(_core.modes_state(scene.to_json(), _finite("state time", t_s, "s"),
+                                                  _as_list(q), _as_list(v)))
     t = scene_torque(scene) if torque is None else _finite("torque", torque, "N m")
     psi = _finite("crank_angle", crank_angle, "rad")
     return Modes._from_core(_core.modes(scene.to_json(), t, [psi])[0])
+
+
+def modes_at(result: Any, t: float | None = None) -> Modes:
+    """Modes about the state of a dynamic run (:class:`rvdyn.Result` of :func:`rvdyn.simulate`)
+    at its end (``t=None``, any joints) or at the recorded sample nearest to ``t`` [s] (rigid
+    joints: their whole state is in the ``"motion"`` channels). A compliant model's crank
+    centres and disc speeds are not recorded: for a time inside a compliant run, simulate to
+    that time and take the end. See :func:`modes` (``state=``) for the method.
+
+    Raises :class:`rvdyn.ParameterError` for a result without the end state (saved before it
+    was kept), a time outside the run, or a compliant run with ``t``."""
+    from ..result import Result
+    from ..scene import Scene
+
+    if not isinstance(result, Result):
+        raise ParameterError(f"result must be an rvdyn.Result, got {type(result).__name__}")
+    if not result.scene:
+        raise ParameterError("the result carries no scene: modes_at needs the scene it was run with")
+    scene = Scene(result.scene)
+    stats = result.stats
+    if t is None:
+        if "final_q" not in stats:
+            raise ParameterError("this result has no end state (stats['final_q']); run it again with this version")
+        return modes(scene, state=(float(stats["final_time"]), stats["final_q"], stats["final_v"]))
+    tt = _finite("t", t, "s")
+    coords = _core.rigid_coordinates(scene.to_json())
+    if coords is None:
+        raise ParameterError("a compliant run records neither the crank centres nor the disc speeds: "
+                             "simulate to t and call modes_at(result) for the end state")
+    times = np.asarray(result.t)
+    if not times[0] - 1e-12 <= tt <= times[-1] + 1e-12:
+        raise ParameterError(f"t = {tt} s is outside the run [{times[0]}, {times[-1]}] s")
+    try:
+        ang = [result.carrier_angle, result.crank_angle[:, 0], result.sun_angle, result.load_angle,
+               result.motor_angle]
+        spd = [result.carrier_speed, result.crank_speed[:, 0], result.sun_speed, result.load_speed,
+               result.motor_speed]
+    except AttributeError:
+        raise ParameterError('modes_at(result, t) needs the "motion" channels recorded') from None
+    i = int(np.argmin(np.abs(times - tt)))
+    q = [float(ang[c][i]) for c in coords]
+    v = [float(spd[c][i]) for c in coords]
+    return modes(scene, state=(float(times[i]), q, v))
 
 
 @dataclass

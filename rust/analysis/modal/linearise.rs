@@ -27,7 +27,7 @@ use crate::analysis::ltca::statics::{CARRIER, Dense, Family, Kind, SUN, Statics,
 use crate::analysis::modal::{LinearSystem, StiffnessPart};
 use crate::dynamics::model::ReducerModel;
 use crate::dynamics::model::compliant::CompliantModel;
-use crate::dynamics::model::rigid::RigidModel;
+use crate::dynamics::model::rigid::{FULL, LOAD, MOTOR, RigidModel, SUN as RSUN};
 use crate::dynamics::model::rigid_system::RigidSystem;
 use crate::dynamics::scene::{Drive, Joints, Load, Scene};
 use crate::error::{Result, RvdynError, require_finite};
@@ -37,11 +37,22 @@ use nalgebra::{DMatrix, DVector};
 /// built with a zero torque drive and no load: the input is a free coordinate held at the
 /// equilibrium's angle, and only derivatives of the force are used.
 enum Dynamic {
-    /// Rigid joints; the position of each free coordinate of the model in `[th_c, alpha, th_s]`
-    /// is the model's own `free` list.
+    /// Rigid joints (full coordinates `[th_c, alpha, th_s, th_L, th_m]`).
     Rigid(Box<RigidModel>),
-    /// Compliant joints and the position of each full coordinate in the model's free list.
-    Compliant(Box<CompliantModel>, Vec<Option<usize>>),
+    /// Compliant joints (the model's full coordinates).
+    Compliant(Box<CompliantModel>),
+}
+
+/// A coordinate the linearisation adds to the LTCA unknowns when the scene has machine shafts
+/// (docs/model.md, "Modes with machine shafts").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Extra {
+    /// The sun angle, free on the drive shaft.
+    Sun,
+    /// The load angle at the end of the output shaft.
+    Load,
+    /// The motor angle (a torque drive with a drive shaft).
+    Motor,
 }
 
 /// The operating point a linearisation was taken at.
@@ -61,6 +72,14 @@ pub struct Equilibrium {
     pub iterations: usize,
     /// `|sum_p K_p - K|_F / |K|_F` of the stiffness split.
     pub split_error: f64,
+    /// Angles of the load and the motor [rad] (the carrier's and the sun's without shafts).
+    pub shaft_angles: [f64; 2],
+    /// Full coordinates and velocities of the dynamic model at the operating point (its own
+    /// layout: `[th_c, alpha, th_s, th_L, th_m]` for rigid joints, the compliant full vector
+    /// otherwise); velocities zero at an equilibrium.
+    pub dynamic_state: (Vec<f64>, Vec<f64>),
+    /// Time of the dynamic state [s] (0 for an equilibrium).
+    pub time: f64,
 }
 
 /// Linearises one scene about LTCA equilibria (warm-started from the previous one).
@@ -72,6 +91,16 @@ pub struct Linearizer {
     names: Vec<String>,
     mass: Vec<f64>,
     dynamic: Dynamic,
+    /// Coordinates added for the shafts (after the LTCA unknowns).
+    extra: Vec<Extra>,
+    /// Index of each linearisation coordinate in the dynamic model's full coordinates.
+    dyn_index: Vec<usize>,
+    /// Position of each of the dynamic model's full coordinates among its free ones.
+    dyn_pos: Vec<Option<usize>>,
+    /// Length scale of each coordinate [m per unit].
+    scale: Vec<f64>,
+    output_shaft: Option<crate::dynamics::scene::Shaft>,
+    input_shaft: Option<crate::dynamics::scene::Shaft>,
 }
 
 impl Linearizer {
@@ -105,7 +134,19 @@ impl Linearizer {
         // needs a speed drive).
         free_scene.initial = crate::dynamics::scene::Initial::Rest;
         let full = full_names(&statics);
-        let (names, mass, dynamic) = match scene.joints {
+        // The sun is free on a drive shaft (the motor held by a speed drive, or free under a
+        // torque drive); the load is free on an output shaft.
+        let mut extra = Vec::new();
+        if scene.shafts.input.is_some() {
+            extra.push(Extra::Sun);
+        }
+        if scene.shafts.output.is_some() {
+            extra.push(Extra::Load);
+        }
+        if scene.shafts.input.is_some() && matches!(scene.drive, Drive::Torque { .. }) {
+            extra.push(Extra::Motor);
+        }
+        let (mut names, mut mass, dynamic): (Vec<String>, Vec<f64>, Dynamic) = match scene.joints {
             Joints::Rigid => {
                 let m = RigidModel::new(&free_scene)?;
                 let mut names = vec!["carrier angle".to_string()];
@@ -120,13 +161,57 @@ impl Linearizer {
                 let m = CompliantModel::new(&free_scene)?;
                 let names = statics.unknowns.iter().map(|&i| full[i].clone()).collect();
                 let mass = statics.unknowns.iter().map(|&i| m.mass[i]).collect();
-                let mut pos = vec![None; m.full_len()];
-                for (k, &i) in m.free.iter().enumerate() {
-                    pos[i] = Some(k);
-                }
-                (names, mass, Dynamic::Compliant(Box::new(m), pos))
+                (names, mass, Dynamic::Compliant(Box::new(m)))
             }
         };
+        let mut dyn_index: Vec<usize> = match &dynamic {
+            Dynamic::Rigid(_) => (0..statics.dim()).collect(),
+            Dynamic::Compliant(_) => statics.unknowns.clone(),
+        };
+        let mut scale = statics.scale.clone();
+        let sun_lever = statics.model.mesh.map_or(1.0, |m| m.sun_base_radius);
+        let rp = scene.cycloid.pin_circle_radius;
+        for e in &extra {
+            let (name, idx, lever) = match (&dynamic, e) {
+                (Dynamic::Rigid(_), Extra::Sun) => ("sun angle", RSUN, sun_lever),
+                (Dynamic::Rigid(_), Extra::Load) => ("load angle", LOAD, rp),
+                (Dynamic::Rigid(_), Extra::Motor) => ("motor angle", MOTOR, sun_lever),
+                (Dynamic::Compliant(_), Extra::Sun) => ("sun angle", SUN, sun_lever),
+                (Dynamic::Compliant(m), Extra::Load) => {
+                    ("load angle", m.load_index.unwrap_or(usize::MAX), rp)
+                }
+                (Dynamic::Compliant(m), Extra::Motor) => (
+                    "motor angle",
+                    m.motor_index.unwrap_or(usize::MAX),
+                    sun_lever,
+                ),
+            };
+            let mm = match &dynamic {
+                Dynamic::Rigid(m) => m.mass.get(idx).copied(),
+                Dynamic::Compliant(m) => m.mass.get(idx).copied(),
+            }
+            .ok_or_else(|| RvdynError::Parameter("shaft coordinate missing in the model".into()))?;
+            names.push(name.into());
+            mass.push(mm);
+            dyn_index.push(idx);
+            scale.push(lever);
+        }
+        let (dyn_len, coords): (usize, Vec<usize>) = match &dynamic {
+            Dynamic::Rigid(m) => (FULL, RigidSystem::new(m).coords.clone()),
+            Dynamic::Compliant(m) => (m.full_len(), m.coords.clone()),
+        };
+        let mut dyn_pos = vec![None; dyn_len];
+        for (k, &i) in coords.iter().enumerate() {
+            dyn_pos[i] = Some(k);
+        }
+        if let Some(&i) = dyn_index
+            .iter()
+            .find(|&&i| dyn_pos.get(i).is_none_or(|p| p.is_none()))
+        {
+            return Err(RvdynError::Parameter(format!(
+                "coordinate {i} of the linearisation is not free in the dynamic model"
+            )));
+        }
         if let Some((i, m)) = mass
             .iter()
             .enumerate()
@@ -146,6 +231,12 @@ impl Linearizer {
             names,
             mass,
             dynamic,
+            extra,
+            dyn_index,
+            dyn_pos,
+            scale,
+            output_shaft: scene.shafts.output,
+            input_shaft: scene.shafts.input,
         })
     }
 
@@ -166,14 +257,151 @@ impl Linearizer {
         require_finite("torque", torque)?;
         require_finite("crank angle", crank_angle)?;
         let (q, rep) = self.ltca.solve_unknowns(torque, crank_angle)?;
+        let full = self.statics.full(crank_angle, &q);
+        // Static shaft twists: the output shaft carries the torque, the drive shaft the
+        // input reaction (docs/model.md, "Modes with machine shafts").
+        let (th_c, th_s) = (full[CARRIER], full[SUN]);
+        let mut shaft_angles = [th_c, th_s];
+        if let Some(sh) = &self.output_shaft {
+            shaft_angles[0] = th_c - torque / sh.stiffness;
+        }
+        if let Some(sh) = &self.input_shaft {
+            let n = self.statics.dim();
+            let (mut r, mut k) = (vec![0.0; n], Dense::zeros(n));
+            self.statics.eval(
+                crank_angle,
+                &q,
+                torque,
+                &mut r,
+                &mut k,
+                &mut self.work,
+                None,
+            )?;
+            shaft_angles[1] = th_s + self.statics.input_reaction(&self.work) / sh.stiffness;
+        }
+        let dynamic_state = self.dynamic_pose(&full, shaft_angles);
         Ok(Equilibrium {
             crank_angle,
             torque,
-            full: self.statics.full(crank_angle, &q),
+            full,
             unknowns: q,
             residual: rep.residual,
             iterations: rep.iterations,
             split_error: 0.0,
+            shaft_angles,
+            dynamic_state,
+            time: 0.0,
+        })
+    }
+
+    /// The dynamic model's full state at rest from the compliant-style pose and the shaft
+    /// angles.
+    fn dynamic_pose(&self, full: &[f64], shaft_angles: [f64; 2]) -> (Vec<f64>, Vec<f64>) {
+        match &self.dynamic {
+            Dynamic::Rigid(_) => {
+                let alpha = full[self.statics.crank_index(0) + 2];
+                let x = vec![
+                    full[CARRIER],
+                    alpha,
+                    full[SUN],
+                    shaft_angles[0],
+                    shaft_angles[1],
+                ];
+                (x, vec![0.0; FULL])
+            }
+            Dynamic::Compliant(m) => {
+                let mut x = vec![0.0; m.full_len()];
+                x[..full.len()].copy_from_slice(full);
+                if let Some(i) = m.load_index {
+                    x[i] = shaft_angles[0];
+                }
+                if let Some(i) = m.motor_index {
+                    x[i] = shaft_angles[1];
+                }
+                let n = x.len();
+                (x, vec![0.0; n])
+            }
+        }
+    }
+
+    /// The operating point of a state `(q, v)` at time `t` [s] of a dynamic run of `scene`
+    /// (the scene this linearizer was built from): `q`, `v` in the run model's free
+    /// coordinates (`ReducerModel::initial_state` order; rad, m, rad/s, m/s). The pose is
+    /// taken as it is (no equilibrium is solved): the held input at its angle at `t`, the
+    /// crank angle that puts it there.
+    ///
+    /// Errors: a scene with other joints or shafts, a state of the wrong length or not
+    /// finite (`Parameter`).
+    pub fn state_point(&self, scene: &Scene, t: f64, q: &[f64], v: &[f64]) -> Result<Equilibrium> {
+        require_finite("time", t)?;
+        if !q.iter().chain(v).all(|x| x.is_finite()) {
+            return Err(RvdynError::Parameter(
+                "the state (q, v) must be finite".into(),
+            ));
+        }
+        let wrong = |n: usize| {
+            RvdynError::Parameter(format!(
+                "the state has {} coordinates and {} velocities, but the model of this scene \
+                 has {n} free coordinates (ReducerModel::initial_state order)",
+                q.len(),
+                v.len()
+            ))
+        };
+        let st = &self.statics;
+        let has_mesh = st.model.mesh.is_some();
+        // d(held input)/d(crank angle) (the map is linear through 0).
+        let gear = st.held_input(1.0);
+        let (x, xv, psi, unknowns, shaft_angles) = match (&self.dynamic, &scene.joints) {
+            (Dynamic::Rigid(_), Joints::Rigid) => {
+                let m = RigidModel::new(scene)?;
+                let sys = RigidSystem::new(&m);
+                if q.len() != sys.coords.len() || v.len() != sys.coords.len() {
+                    return Err(wrong(sys.coords.len()));
+                }
+                let (x, xv, _) = sys.full(t, q, v);
+                let (psi, u) = if has_mesh {
+                    (x[RSUN] / gear, vec![x[CARRIER], x[1]])
+                } else {
+                    (x[1], vec![x[CARRIER]])
+                };
+                (x.to_vec(), xv.to_vec(), psi, u, [x[LOAD], x[MOTOR]])
+            }
+            (Dynamic::Compliant(_), Joints::Compliant { .. }) => {
+                let m = CompliantModel::new(scene)?;
+                if q.len() != m.coords.len() || v.len() != m.coords.len() {
+                    return Err(wrong(m.coords.len()));
+                }
+                let (x, xv, _) = m.full(t, q, v);
+                let psi = if has_mesh {
+                    x[SUN] / gear
+                } else {
+                    x[st.crank_index(0) + 2]
+                };
+                let u: Vec<f64> = st.unknowns.iter().map(|&i| x[i]).collect();
+                let sa = [
+                    m.load_index.map_or(x[CARRIER], |i| x[i]),
+                    m.motor_index.map_or(x[SUN], |i| x[i]),
+                ];
+                (x, xv, psi, u, sa)
+            }
+            _ => {
+                return Err(RvdynError::Parameter(
+                    "the state's scene has other joints than the linearizer's".into(),
+                ));
+            }
+        };
+        let full = st.full(psi, &unknowns);
+        Ok(Equilibrium {
+            crank_angle: psi,
+            torque: st.model.load.torque(t),
+            full,
+            unknowns,
+            residual: 0.0,
+            iterations: 0,
+            split_error: 0.0,
+            shaft_angles,
+            dynamic_state: (x, xv),
+            time: t,
         })
     }
 
@@ -184,18 +412,44 @@ impl Linearizer {
         torque: f64,
         crank_angle: f64,
     ) -> Result<(LinearSystem, Equilibrium)> {
-        let mut eq = self.equilibrium(torque, crank_angle)?;
+        let eq = self.equilibrium(torque, crank_angle)?;
+        self.linearise_about(eq)
+    }
+
+    /// Linearise about an operating point (an equilibrium or a dynamic state from
+    /// [`Linearizer::state_point`]). The stiffness parts: the analytic static tangent of each
+    /// family of couplings at the pose, the shafts (`k_o`, `k_i`, exact), and at a moving
+    /// state the rate-dependent stiffness `K_fd(q, v) - K_fd(q, 0)` (finite differences of the
+    /// dynamic force: contact damping `c(pen) pen'` and friction at speed).
+    pub fn linearise_about(&mut self, mut eq: Equilibrium) -> Result<(LinearSystem, Equilibrium)> {
         let n = self.names.len();
-        let k_all = self.tangent_stiffness(&eq)?;
-        let mut parts = Vec::with_capacity(self.families.len());
+        let mut k_all = self.reducer_stiffness(&eq)?;
+        let mut parts = Vec::with_capacity(self.families.len() + 2);
         let mut sum = DMatrix::<f64>::zeros(n, n);
         for (name, fam) in self.families.clone() {
             self.statics.family = Some(fam);
-            let k = self.tangent_stiffness(&eq);
+            let k = self.reducer_stiffness(&eq);
             self.statics.family = None;
             let k = k?;
             sum += &k;
             parts.push(StiffnessPart { name, matrix: k });
+        }
+        if let Some(ks) = self.shaft_stiffness() {
+            k_all += &ks;
+            sum += &ks;
+            parts.push(StiffnessPart {
+                name: "shafts".into(),
+                matrix: ks,
+            });
+        }
+        if eq.dynamic_state.1.iter().any(|v| *v != 0.0) {
+            let rate = &self.fd_stiffness(&eq, true)? - &self.fd_stiffness(&eq, false)?;
+            k_all += &rate;
+            sum += &rate;
+            parts.push(StiffnessPart {
+                name: "rate-dependent".into(),
+                matrix: rate,
+            });
         }
         let norm = k_all.norm();
         eq.split_error = if norm > 0.0 {
@@ -209,13 +463,13 @@ impl Linearizer {
             mass: DMatrix::from_diagonal(&DVector::from_vec(self.mass.clone())),
             stiffness: parts,
             damping,
-            length_scale: self.statics.scale.clone(),
+            length_scale: self.scale.clone(),
         };
         Ok((sys, eq))
     }
 
-    /// The analytic tangent stiffness `-dQ/dq` at an equilibrium [N/m, N m/rad, N] (of the
-    /// family set on the statics, or of all couplings).
+    /// The analytic tangent stiffness `-dQ/dq` of the LTCA unknowns at an equilibrium [N/m,
+    /// N m/rad, N] (of the family set on the statics, or of all couplings).
     pub fn tangent_stiffness(&mut self, eq: &Equilibrium) -> Result<DMatrix<f64>> {
         let st = &mut self.statics;
         let n = st.dim();
@@ -233,10 +487,117 @@ impl Linearizer {
         Ok(DMatrix::from_row_slice(n, n, &k.a))
     }
 
+    /// The reducer's analytic tangent stiffness on all the linearisation's coordinates: that
+    /// of the LTCA unknowns, and with a drive shaft the sun's row and column (`J^T K_full e_s`
+    /// with the map Jacobian `J` of the unknowns; the sun enters the map linearly).
+    fn reducer_stiffness(&mut self, eq: &Equilibrium) -> Result<DMatrix<f64>> {
+        let k0 = self.tangent_stiffness(eq)?;
+        let n0 = k0.nrows();
+        let n = self.names.len();
+        let mut k = DMatrix::<f64>::zeros(n, n);
+        k.view_mut((0, 0), (n0, n0)).copy_from(&k0);
+        if let Some(s) = self.extra.iter().position(|e| *e == Extra::Sun) {
+            let s = n0 + s;
+            let kf = &self.work.kf;
+            let jac = self.map_jacobian(&eq.full);
+            for (a, col) in jac.iter().enumerate() {
+                k[(a, s)] = col.iter().map(|&(i, w)| w * kf.at(i, SUN)).sum();
+                k[(s, a)] = col.iter().map(|&(i, w)| w * kf.at(SUN, i)).sum();
+            }
+            k[(s, s)] = kf.at(SUN, SUN);
+        }
+        Ok(k)
+    }
+
+    /// Columns of the map from the LTCA unknowns to the full coordinates at the pose `x`
+    /// (as `Statics::eval` builds them): `(full index, d x_i / d q_a)`.
+    fn map_jacobian(&self, x: &[f64]) -> Vec<Vec<(usize, f64)>> {
+        let st = &self.statics;
+        let m = &st.model;
+        let n = st.dim();
+        let seat = |i: usize| {
+            let a = x[CARRIER] + std::f64::consts::TAU * i as f64 / st.cranks as f64;
+            [m.crank_radius * a.cos(), m.crank_radius * a.sin()]
+        };
+        let mut jac = vec![Vec::new(); n];
+        match st.kind {
+            Kind::Rigid => {
+                jac[0].push((CARRIER, 1.0));
+                for k in 0..m.discs.len() {
+                    jac[0].push((st.disc_index(k) + 2, 1.0));
+                }
+                for i in 0..st.cranks {
+                    let p = seat(i);
+                    let ci = st.crank_index(i);
+                    jac[0].push((ci, -p[1]));
+                    jac[0].push((ci + 1, p[0]));
+                }
+                if n == 2 {
+                    for i in 0..st.cranks {
+                        jac[1].push((st.crank_index(i) + 2, 1.0));
+                    }
+                    for k in 0..m.discs.len() {
+                        let dk = st.disc_index(k);
+                        jac[1].push((dk, -x[dk + 1]));
+                        jac[1].push((dk + 1, x[dk]));
+                    }
+                }
+            }
+            Kind::Compliant => {
+                for (a, &i) in st.unknowns.iter().enumerate() {
+                    jac[a].push((i, 1.0));
+                    if i == CARRIER && st.crank_bearing.is_none() {
+                        for c in 0..st.cranks {
+                            let p = seat(c);
+                            let ci = st.crank_index(c);
+                            jac[a].push((ci, -p[1]));
+                            jac[a].push((ci + 1, p[0]));
+                        }
+                    }
+                }
+            }
+        }
+        jac
+    }
+
+    /// The shafts' stiffness on the linearisation's coordinates (exact: linear springs);
+    /// `None` without shafts. A drive shaft with the motor held ties the sun to the ground.
+    fn shaft_stiffness(&self) -> Option<DMatrix<f64>> {
+        if self.extra.is_empty() {
+            return None;
+        }
+        let n = self.names.len();
+        let n0 = self.statics.dim();
+        let at = |e: Extra| self.extra.iter().position(|x| *x == e).map(|p| n0 + p);
+        let mut k = DMatrix::<f64>::zeros(n, n);
+        let mut spring = |a: usize, b: Option<usize>, kk: f64| {
+            k[(a, a)] += kk;
+            if let Some(b) = b {
+                k[(b, b)] += kk;
+                k[(a, b)] -= kk;
+                k[(b, a)] -= kk;
+            }
+        };
+        if let (Some(sh), Some(l)) = (&self.output_shaft, at(Extra::Load)) {
+            spring(l, Some(0), sh.stiffness);
+        }
+        if let (Some(sh), Some(s)) = (&self.input_shaft, at(Extra::Sun)) {
+            spring(s, at(Extra::Motor), sh.stiffness);
+        }
+        Some(k)
+    }
+
     /// The dynamic model's generalised force on the linearisation's coordinates at the
-    /// equilibrium pose displaced by `dq` with velocities `v` (no load and no drive torque:
-    /// only derivatives of it are meaningful) [N, N m]. `dq`, `v`: one entry per coordinate.
+    /// operating point's state displaced by `dq` with velocities changed by `v` (no load and
+    /// no drive torque: only derivatives of it are meaningful) [N, N m]. `dq`, `v`: one entry
+    /// per coordinate.
     pub fn dynamic_force(&self, eq: &Equilibrium, dq: &[f64], v: &[f64]) -> Result<Vec<f64>> {
+        self.force_at(eq, dq, v, true)
+    }
+
+    /// [`Linearizer::dynamic_force`], about the state's velocities or (`moving = false`) at
+    /// rest.
+    fn force_at(&self, eq: &Equilibrium, dq: &[f64], v: &[f64], moving: bool) -> Result<Vec<f64>> {
         let n = self.names.len();
         if dq.len() != n || v.len() != n {
             return Err(RvdynError::Parameter(format!(
@@ -245,60 +606,54 @@ impl Linearizer {
                 v.len()
             )));
         }
-        match &self.dynamic {
-            Dynamic::Rigid(m) => {
-                // [th_c, alpha, th_s]; the unknowns are th_c and (with a first stage) alpha.
-                let alpha = if n == 2 {
-                    eq.unknowns[1]
-                } else {
-                    eq.crank_angle
-                };
-                let mut x = [eq.full[CARRIER], alpha, eq.full[SUN]];
-                let mut xv = [0.0; 3];
-                for (xa, d) in x.iter_mut().zip(dq) {
-                    *xa += d;
-                }
-                xv[..n].copy_from_slice(v);
-                let sys = RigidSystem::new(m);
-                let q: Vec<f64> = m.free.iter().map(|&i| x[i]).collect();
-                let qv: Vec<f64> = m.free.iter().map(|&i| xv[i]).collect();
-                let mut f = vec![0.0; q.len()];
-                sys.generalized_force(0.0, &q, &qv, &mut f)?;
-                (0..n)
-                    .map(|a| {
-                        m.free
-                            .iter()
-                            .position(|&i| i == a)
-                            .map(|k| f[k])
-                            .ok_or_else(|| {
-                                RvdynError::Parameter(
-                                    "coordinate maps differ between models".into(),
-                                )
-                            })
-                    })
-                    .collect()
-            }
-            Dynamic::Compliant(m, pos) => {
-                let nf = m.free.len();
-                let mut qf = vec![0.0; nf];
-                let mut vf = vec![0.0; nf];
-                for (k, &i) in m.free.iter().enumerate() {
-                    qf[k] = eq.full[i];
-                }
-                let mut at = Vec::with_capacity(n);
-                for (a, &i) in self.statics.unknowns.iter().enumerate() {
-                    let k = pos[i].ok_or_else(|| {
-                        RvdynError::Parameter("coordinate maps differ between models".into())
-                    })?;
-                    qf[k] += dq[a];
-                    vf[k] = v[a];
-                    at.push(k);
-                }
-                let mut f = vec![0.0; nf];
-                m.generalized_force(0.0, &qf, &vf, &mut f)?;
-                Ok(at.into_iter().map(|k| f[k]).collect())
+        let (x, xv) = &eq.dynamic_state;
+        let nc = self.dyn_pos.iter().flatten().count();
+        let mut qc = vec![0.0; nc];
+        let mut vc = vec![0.0; nc];
+        for (i, p) in self.dyn_pos.iter().enumerate() {
+            if let Some(p) = *p {
+                qc[p] = x[i];
+                vc[p] = if moving { xv[i] } else { 0.0 };
             }
         }
+        let pos: Vec<usize> = self
+            .dyn_index
+            .iter()
+            .map(|&i| self.dyn_pos[i].unwrap_or(0))
+            .collect();
+        for (a, &p) in pos.iter().enumerate() {
+            qc[p] += dq[a];
+            vc[p] += v[a];
+        }
+        let mut f = vec![0.0; nc];
+        match &self.dynamic {
+            Dynamic::Rigid(m) => {
+                RigidSystem::new(m).generalized_force(eq.time, &qc, &vc, &mut f)?
+            }
+            Dynamic::Compliant(m) => m.generalized_force(eq.time, &qc, &vc, &mut f)?,
+        }
+        Ok(pos.iter().map(|&p| f[p]).collect())
+    }
+
+    /// `K = -dQ/dq` by forward differences of the dynamic force (the perturbations of
+    /// `solve::jacobian`), about the state's velocities or at rest.
+    fn fd_stiffness(&self, eq: &Equilibrium, moving: bool) -> Result<DMatrix<f64>> {
+        use crate::solve::jacobian::DISPLACEMENT_STEP;
+        let n = self.names.len();
+        let zero = vec![0.0; n];
+        let f0 = self.force_at(eq, &zero, &zero, moving)?;
+        let mut k = DMatrix::<f64>::zeros(n, n);
+        let mut dq = vec![0.0; n];
+        for b in 0..n {
+            let h = DISPLACEMENT_STEP / self.scale[b];
+            dq[b] = h;
+            let f1 = self.force_at(eq, &dq, &zero, moving)?;
+            dq[b] = 0.0;
+            for a in 0..n {
+                k[(a, b)] = -(f1[a] - f0[a]) / h;
+            }
+        }
+        Ok(k)
     }
 
     /// `C = -dQ/dv` by forward differences (exact for rate-linear damping laws).
@@ -310,7 +665,7 @@ impl Linearizer {
         let mut v = vec![0.0; n];
         for b in 0..n {
             // 1 mm/s at the coordinate's lever: small against any separation speed.
-            let dv = 1e-3 / self.statics.scale[b];
+            let dv = 1e-3 / self.scale[b];
             v[b] = dv;
             let q1 = self.dynamic_force(eq, &zero, &v)?;
             v[b] = 0.0;

@@ -34,7 +34,7 @@ use nalgebra::{Complex, DMatrix, DVector, SymmetricEigen};
 use std::f64::consts::TAU;
 
 pub use linearise::{Equilibrium, Linearizer};
-pub use sweep::{Campbell, ModalPoint, campbell, modes_at};
+pub use sweep::{Campbell, ModalPoint, campbell, modes_at, modes_at_state};
 
 /// One named contribution to the stiffness matrix (a contact family or a bearing family).
 #[derive(Debug, Clone, PartialEq)]

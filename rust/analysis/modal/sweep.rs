@@ -25,6 +25,10 @@ pub struct ModalPoint {
 /// `torque` [N m].
 pub fn modes_at(lin: &mut Linearizer, torque: f64, crank_angle: f64) -> Result<ModalPoint> {
     let (sys, eq) = lin.linearise(torque, crank_angle)?;
+    point(sys, eq)
+}
+
+fn point(sys: crate::analysis::modal::LinearSystem, eq: Equilibrium) -> Result<ModalPoint> {
     let analysis = modal_analysis(&sys)?;
     let n = sys.dof_names.len();
     let mut k = nalgebra::DMatrix::<f64>::zeros(n, n);
@@ -131,4 +135,19 @@ pub fn campbell(
         orders,
         crossings,
     })
+}
+
+/// Modes of `scene` about the state `(q, v)` at time `t` [s] of a dynamic run (the run
+/// model's free coordinates and velocities, `ReducerModel::initial_state` order), with the
+/// linearizer `lin` built from the same scene (see [`Linearizer::state_point`]).
+pub fn modes_at_state(
+    lin: &mut Linearizer,
+    scene: &Scene,
+    t: f64,
+    q: &[f64],
+    v: &[f64],
+) -> Result<ModalPoint> {
+    let eq = lin.state_point(scene, t, q, v)?;
+    let (sys, eq) = lin.linearise_about(eq)?;
+    point(sys, eq)
 }

@@ -582,3 +582,223 @@ fn damped_eigenvalues_are_roots_of_the_pencil() {
         assert!(worst < 1e-12, "{}: {worst:e}", scene.name);
     }
 }
+
+// ---- machine shafts and dynamic-run states ------------------------------------------------------
+
+use crate::dynamics::scene::{Drive, Load, Shaft};
+
+/// The rated paper scene with load inertia `jl` [kg m^2] and motor inertia `jm`, an output
+/// shaft `ko` and a drive shaft `ki` [N m/rad] (`None`: rigid connection).
+fn shaft_scene(ko: Option<f64>, ki: Option<f64>, jl: f64, jm: f64, compliant: bool) -> Scene {
+    let mut s = Scene::paper("rated").unwrap();
+    s.inertias.load_inertia = jl;
+    s.inertias.motor_inertia = jm;
+    s.shafts.output = ko.map(|k| Shaft {
+        stiffness: k,
+        damping: 10.0,
+    });
+    s.shafts.input = ki.map(|k| Shaft {
+        stiffness: k,
+        damping: 0.1,
+    });
+    if compliant {
+        s.joints = default_joints();
+    }
+    s
+}
+
+fn torque_driven(mut s: Scene) -> Scene {
+    s.drive = Drive::Torque {
+        torque: rated_torque() / s.ratio(),
+        ramp_time: 0.0,
+    };
+    s
+}
+
+#[test]
+fn shaft_coordinates_are_named_and_their_tangent_equals_finite_differences() {
+    // With shafts the linearisation adds the sun (free on the drive shaft), the load and (torque
+    // drive) the motor; its stiffness (the LTCA's analytic tangent with the sun's row and
+    // column from the full-coordinate tangent, plus the shafts' springs) must equal central
+    // differences of the dynamic model's generalised force over every coordinate (1e-5
+    // relative in displacement units, as the test without shafts). The number of modes equals
+    // the number of coordinates.
+    let t = rated_torque();
+    for compliant in [false, true] {
+        let speed = shaft_scene(Some(2e6), Some(5e4), 20.0, 0.05, compliant);
+        for (scene, extra) in [
+            (speed.clone(), vec!["sun angle", "load angle"]),
+            (
+                torque_driven(speed),
+                vec!["sun angle", "load angle", "motor angle"],
+            ),
+        ] {
+            let mut lin = Linearizer::new(&scene).unwrap();
+            let (sys, eq) = lin.linearise(t, 0.37).unwrap();
+            let n = sys.dof_names.len();
+            assert_eq!(&sys.dof_names[n - extra.len()..], extra.as_slice());
+            assert_eq!(sys.stiffness.last().unwrap().name, "shafts");
+            assert!(eq.split_error < 1e-12, "split {}", eq.split_error);
+            let mut k = DMatrix::<f64>::zeros(n, n);
+            for p in &sys.stiffness {
+                k += &p.matrix;
+            }
+            let zero = vec![0.0; n];
+            let mut fd = DMatrix::<f64>::zeros(n, n);
+            for b in 0..n {
+                let h = 1e-8 / sys.length_scale[b];
+                let mut dq = zero.clone();
+                dq[b] = h;
+                let qp = lin.dynamic_force(&eq, &dq, &zero).unwrap();
+                dq[b] = -h;
+                let qm = lin.dynamic_force(&eq, &dq, &zero).unwrap();
+                for a in 0..n {
+                    fd[(a, b)] = -(qp[a] - qm[a]) / (2.0 * h);
+                }
+            }
+            let mut worst: f64 = 0.0;
+            let mut scale: f64 = 0.0;
+            for a in 0..n {
+                for b in 0..n {
+                    let s = 1.0 / (sys.length_scale[a] * sys.length_scale[b]);
+                    worst = worst.max((k[(a, b)] - fd[(a, b)]).abs() * s);
+                    scale = scale.max(k[(a, b)].abs() * s);
+                }
+            }
+            println!(
+                "shafts compliant={compliant} n={n}: FD {:.1e}",
+                worst / scale
+            );
+            assert!(worst < 1e-5 * scale, "{n} dof: {worst:e} of {scale:e}");
+            // The shafts' damping is in C: the load row holds -c_o on the carrier.
+            let l = sys
+                .dof_names
+                .iter()
+                .position(|d| d == "load angle")
+                .unwrap();
+            assert!((sys.damping[(l, 0)] + 10.0).abs() < 1e-6 * 10.0);
+            let r = modal_analysis(&sys).unwrap();
+            assert_eq!(r.modes.len(), n);
+        }
+    }
+}
+
+/// Reflected inertia of the rigid reducer (with the motor) at the carrier: `r^T M r` over the
+/// kinematic direction `r = d(coordinate)/d(th_c)`: crank `-zc`, sun and motor the gear ratio
+/// `i = ratio` (docs/model.md, "Modes with machine shafts").
+fn reflected_inertia(sys: &LinearSystem, scene: &Scene) -> f64 {
+    let zc = f64::from(scene.cycloid.pins - 1);
+    let i = scene.ratio();
+    sys.dof_names
+        .iter()
+        .enumerate()
+        .map(|(a, name)| {
+            let r = match name.as_str() {
+                "carrier angle" => 1.0,
+                "crank angle" => -zc,
+                "sun angle" | "motor angle" => i,
+                _ => 0.0,
+            };
+            sys.mass[(a, a)] * r * r
+        })
+        .sum()
+}
+
+#[test]
+fn soft_output_shaft_gives_the_two_inertia_frequency() {
+    // Torque drive, stiff drive shaft (the motor free with the reducer), very soft output
+    // shaft: the lowest elastic mode is the load against the whole drive train,
+    // w^2 = k_o (1/J_L + 1/J_red), J_red the reducer and motor reflected to the carrier
+    // (r^T M r along the kinematic direction). The reducer's own flexibility adds a relative
+    // error of order (w / w_reducer)^2 (2e-5 here).
+    let (ko, jl) = (2e4, 20.0);
+    let scene = torque_driven(shaft_scene(Some(ko), Some(1e9), jl, 0.05, false));
+    let mut lin = Linearizer::new(&scene).unwrap();
+    let (sys, _) = lin.linearise(rated_torque(), 0.2).unwrap();
+    let r = modal_analysis(&sys).unwrap();
+    let jr = reflected_inertia(&sys, &scene);
+    let want = (ko * (1.0 / jl + 1.0 / jr)).sqrt() / std::f64::consts::TAU;
+    // Mode 0 is the drive train's kinematic motion (free under a torque drive), not quite at
+    // 0 Hz: under load the tangent stiffness along the kinematic path is not zero (0.6 Hz
+    // here: the transmitted torque varies with the crank angle), and it shifts the shaft mode
+    // by about (0.6 / 5.3)^2 / 20 = 6e-4, the error measured; tolerance 2e-3 (the issue asks
+    // 1 %).
+    assert!(
+        r.modes[0].frequency < 0.2 * want,
+        "{}",
+        r.modes[0].frequency
+    );
+    let got = r.modes[1].frequency;
+    println!("two-inertia: {got} Hz vs {want} Hz (J_red {jr} kg m^2)");
+    assert!(rel(got, want) < 2e-3, "{got} vs {want}");
+    let shafts = r.part_names.iter().position(|p| p == "shafts").unwrap();
+    assert!(r.modes[1].energy_share[shafts] > 0.99);
+}
+
+#[test]
+fn stiff_shafts_give_back_the_modes_without_shafts() {
+    // Output and drive shafts 1e5 times stiffer than the reducer at the carrier/sun: the
+    // load joins the carrier and (speed drive: the motor held) the sun is held, as without
+    // shafts; the modes without shafts must come back within 1 % (the issue's tolerance for
+    // the rigid/stiff-bearing limit).
+    let t = rated_torque();
+    for compliant in [false, true] {
+        let base = shaft_scene(None, None, 20.0, 0.05, compliant);
+        let stiff = shaft_scene(Some(1e13), Some(1e12), 20.0, 0.05, compliant);
+        let mut lin = Linearizer::new(&base).unwrap();
+        let a = modal_analysis(&lin.linearise(t, 0.2).unwrap().0).unwrap();
+        let mut lin = Linearizer::new(&stiff).unwrap();
+        let b = modal_analysis(&lin.linearise(t, 0.2).unwrap().0).unwrap();
+        assert_eq!(b.modes.len(), a.modes.len() + 2);
+        let mut worst: f64 = 0.0;
+        for (x, y) in a.modes.iter().zip(&b.modes) {
+            worst = worst.max(rel(y.frequency, x.frequency));
+        }
+        println!("stiff shafts compliant={compliant}: worst {worst:.2e}");
+        assert!(worst < 0.01, "{worst}");
+    }
+}
+
+#[test]
+fn state_of_a_slow_run_linearises_like_the_equilibrium() {
+    // The rigid paper reducer turning at 1 % of the paper's speed with the load ramped to rated
+    // over 0.05 s, run to 0.12 s (the paper's damping settles the ramp's transient): the
+    // state at the end is the loaded equilibrium at its crank angle up to the slow motion's
+    // damping and inertia forces. Its linearisation must have as many modes as the model's
+    // free coordinates and give the equilibrium linearisation's frequencies within 1e-3
+    // (measured in the output; the pose differs from the equilibrium by the contact
+    // deflection the damping forces of the slow motion add).
+    use crate::dynamics::run::driver::{RunControl, SimOptions, simulate};
+    use crate::solve::Method;
+    let t_rated = rated_torque();
+    let mut scene = Scene::paper("rated").unwrap();
+    if let Drive::Speed { speed, .. } = &mut scene.drive {
+        *speed *= 0.01;
+    }
+    scene.load = Load::Table {
+        points: vec![[0.0, 0.0], [0.05, t_rated]],
+    };
+    let mut opt = SimOptions::new(0.12, Method::GeneralizedAlpha);
+    opt.dt = Some(1e-4);
+    opt.channels = vec![];
+    let rec = simulate(&scene, &opt, &RunControl::default()).unwrap();
+    let (t, q, v) = rec.final_state.unwrap();
+    let mut lin = Linearizer::new(&scene).unwrap();
+    let p = modes_at_state(&mut lin, &scene, t, &q, &v).unwrap();
+    assert_eq!(p.analysis.modes.len(), q.len());
+    assert!((p.equilibrium.torque - t_rated).abs() < 1e-9 * t_rated);
+    let e = modes_at(&mut lin, t_rated, p.equilibrium.crank_angle).unwrap();
+    for (a, b) in p.analysis.modes.iter().zip(&e.analysis.modes) {
+        println!(
+            "state {} Hz, equilibrium {} Hz ({:.1e})",
+            a.frequency,
+            b.frequency,
+            rel(a.frequency, b.frequency)
+        );
+        assert!(rel(a.frequency, b.frequency) < 1e-3);
+    }
+    assert!(p.analysis.part_names.iter().any(|n| n == "rate-dependent"));
+    // A state of the wrong length names the model's count.
+    let e = lin.state_point(&scene, t, &q[..1], &v[..1]).unwrap_err();
+    assert!(e.to_string().contains("2 free coordinates"), "{e}");
+}

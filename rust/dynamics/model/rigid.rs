@@ -16,7 +16,7 @@ use crate::contact::law::PinSite;
 use crate::dynamics::model::parts::MeshOffset;
 pub(crate) use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::pin_contact::{
-    DiscPose, SeparationBound, WarmStart, penetration_error, touching_pin,
+    DiscPose, SeparationBound, WarmStart, penetration_error, pin_law_force, touching_pin,
 };
 use crate::dynamics::run::sink::ContactSink;
 use crate::dynamics::scene::{Initial, Joints, Scene};
@@ -268,7 +268,7 @@ impl RigidModel {
                     pin_radius: pin.radius,
                     depth: d.body_depth,
                 };
-                let lf = self.pin_law.evaluate(pen, pen_rate, &site, want_energy)?;
+                let lf = pin_law_force(&self.pin_law, pen, pen_rate, &site, want_energy, warm)?;
                 let f = lf.force;
                 out.q[CARRIER] -= f * lever_c;
                 out.q[CRANK] -= f * lever_a;
@@ -305,10 +305,13 @@ impl RigidModel {
                 }
                 // Location term of a line law (its energy depends on the contact's place on
                 // the profile): dO/dalpha = z x O, dtheta/dth_c = 1.
-                if let Some(ls) = self
-                    .pin_law
-                    .location_slope(lf.elastic, &site, pin.centre, o, th)
-                {
+                if let Some(ls) = self.pin_law.location_slope_at(
+                    lf.elastic,
+                    &site,
+                    pin.centre,
+                    o,
+                    (pose.sin, pose.cos),
+                ) {
                     let (fo, m) = ls.forces();
                     out.q[CARRIER] += m;
                     out.q[CRANK] += fo[1] * o[0] - fo[0] * o[1];

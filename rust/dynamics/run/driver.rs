@@ -367,5 +367,6 @@ pub fn run_with<M: ReducerModel>(
     }
     let mut out = rec.finish();
     out.stats = integrator.stats();
+    out.final_state = Some((st.t, st.q, st.v));
     Ok(out)
 }

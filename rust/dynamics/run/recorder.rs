@@ -416,6 +416,9 @@ pub struct Recording {
     pub stats: Stats,
     /// Why the run may be inaccurate (see `driver::fixed_step_warnings`).
     pub warnings: Vec<String>,
+    /// The state at the end of the run: time [s] and the model's free coordinates and
+    /// velocities (`ReducerModel::initial_state` order), e.g. for a modal analysis about it.
+    pub final_state: Option<(f64, Vec<f64>, Vec<f64>)>,
 }
 
 /// Collects the contacts of one evaluation into per-sample buffers.
@@ -541,6 +544,7 @@ impl Recorder {
                 samples: 0,
                 stats: Stats::default(),
                 warnings: Vec::new(),
+                final_state: None,
             },
             sink,
             nd,

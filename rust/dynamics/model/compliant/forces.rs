@@ -3,7 +3,9 @@
 
 use super::{CARRIER, CompliantModel, Flows, SUN, crank_index};
 use crate::contact::law::PinSite;
-use crate::dynamics::model::pin_contact::{DiscPose, penetration_error, touching_pin};
+use crate::dynamics::model::pin_contact::{
+    DiscPose, penetration_error, pin_law_force, touching_pin,
+};
 use crate::dynamics::model::vec2::{add, cross, dot, perp, rotate, scaled, sub};
 use crate::dynamics::run::sink::ContactSink;
 use crate::error::{Result, RvdynError};
@@ -206,7 +208,7 @@ impl CompliantModel {
                     pin_radius: pin.radius,
                     depth: disc.body_depth,
                 };
-                let lf = m.pin_law.evaluate(pen, pen_rate, &site, want_energy)?;
+                let lf = pin_law_force(&m.pin_law, pen, pen_rate, &site, want_energy, warm)?;
                 let f = lf.force;
                 qf[dk] -= f * n[0];
                 qf[dk + 1] -= f * n[1];
@@ -232,10 +234,13 @@ impl CompliantModel {
                     out.friction[0] += p;
                 }
                 // Location term of a line law (see `PinLaw::location_slope`).
-                if let Some(ls) = m
-                    .pin_law
-                    .location_slope(lf.elastic, &site, pin.centre, o, th)
-                {
+                if let Some(ls) = m.pin_law.location_slope_at(
+                    lf.elastic,
+                    &site,
+                    pin.centre,
+                    o,
+                    (pose.sin, pose.cos),
+                ) {
                     let (fo, mt) = ls.forces();
                     qf[dk] += fo[0];
                     qf[dk + 1] += fo[1];
