@@ -643,7 +643,7 @@ impl Ltca {
 /// the same lobe position only after the shift is a whole number of rings, `2 pi` of crank
 /// angle. A disc profile error makes the lobes distinguishable: the turned assembly matches
 /// only when the disc has turned by the same whole-ring angle, after `2 pi zc / zp` of crank
-/// angle (`2 pi zc` with pin errors too). An IMPACT mesh law does not vary
+/// angle (`2 pi zc` with pin errors too, or with assembly errors). An IMPACT mesh law does not vary
 /// with the tooth position; the ISO 6336 stiffness varies with the mesh position
 /// `s = r_bs (th_s - th_c)` with the period of one base pitch,
 /// which the held sun passes every `2 pi zc / (z_planet zp)` of crank angle
@@ -661,7 +661,10 @@ pub fn mesh_period(scene: &Scene) -> f64 {
             .as_ref()
             .is_some_and(|p| !p.harmonics.is_empty() || !p.table.is_empty())
     });
+    // Assembly errors make the cranks distinguishable: the carrier must return, after
+    // `2 pi zc` of crank angle (which also brings back the disc and the pins).
     let pitches = match (errors, lobes) {
+        _ if scene.errors.any() => zp * (zp - 1),
         (false, false) => 1,
         (true, false) => zp,
         (false, true) => zp - 1,

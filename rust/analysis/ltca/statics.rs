@@ -186,6 +186,13 @@ pub struct Statics {
     /// `ln F` of each (disc, pin)'s last line-law force (warm start of its inversion).
     ln_warm: Vec<f64>,
     seats: Vec<[f64; 2]>,
+    /// Actual crank seat of each crank in the carrier frame (with its position error) [m]:
+    /// the crank bearing's; the mesh keeps the nominal seat.
+    seat_vecs: Vec<[f64; 2]>,
+    /// Eccentricity of each crank (with its error) [m].
+    ecc_radius: Vec<f64>,
+    /// Eccentric phase error of each crank [rad].
+    ecc_phase: Vec<f64>,
     holes: Vec<[f64; 2]>,
     /// `(sin, cos)` of the pressure angle.
     pressure: [f64; 2],
@@ -229,22 +236,27 @@ impl Statics {
         // Errors the statics do not model yet: say so rather than analyse another reducer.
         let unsupported = if scene.gear_errors.any() {
             Some("gear runout and pitch errors (gear_errors)")
-        } else if scene.errors.any() {
-            Some(
-                "assembly errors (errors: crank eccentricity and phase, disc holes, carrier seats)",
-            )
         } else {
             None
         };
         if let Some(what) = unsupported {
             return Err(RvdynError::Scene(format!(
                 "the quasi-static analysis (LTCA, modes) does not include {what} yet: remove \
-                 them from the scene for this analysis (pin errors, disc profile errors and \
-                 profile modifications are included)"
+                 them from the scene for this analysis (pin errors, disc profile errors, \
+                 assembly errors and profile modifications are included)"
             )));
+        }
+        if scene.errors.any() && matches!(scene.joints, Joints::Rigid) {
+            return Err(RvdynError::Scene(
+                "assembly errors (errors: crank eccentricity and phase, disc holes, carrier \
+                 seats) need compliant joints (as in the dynamic models): set joints to \
+                 compliant or remove them"
+                    .into(),
+            ));
         }
         let mut rigid_scene = scene.clone();
         rigid_scene.joints = Joints::Rigid;
+        rigid_scene.errors = Default::default();
         let model = RigidModel::new(&rigid_scene)?;
         let (kind, eccentric_bearing, crank_bearing) = match scene.joints {
             Joints::Rigid => (Kind::Rigid, None, None),
@@ -265,12 +277,34 @@ impl Statics {
         let nd = model.discs.len();
         let seats: Vec<[f64; 2]> = (0..n).map(|i| cos_sin(TAU * i as f64 / n as f64)).collect();
         let mut holes = Vec::with_capacity(n * nd);
-        for seat in &seats {
-            for d in &model.discs {
+        // Assembly errors (compliant joints), as the compliant model: disc hole and carrier
+        // seat position errors, and each crank's eccentricity and phase errors.
+        let errs = &scene.errors;
+        for (i, seat) in seats.iter().enumerate() {
+            for (k, d) in model.discs.iter().enumerate() {
                 let r = [model.crank_radius * seat[0], model.crank_radius * seat[1]];
-                holes.push(rotate(cos_sin(-d.angle_offset), r));
+                let h = rotate(cos_sin(-d.angle_offset), r);
+                let dh = errs.disc_holes.get(i * nd + k).copied().unwrap_or([0.0; 2]);
+                holes.push([h[0] + dh[0], h[1] + dh[1]]);
             }
         }
+        let seat_vecs: Vec<[f64; 2]> = seats
+            .iter()
+            .enumerate()
+            .map(|(i, u)| {
+                let ds = errs.carrier_seats.get(i).copied().unwrap_or([0.0; 2]);
+                [
+                    model.crank_radius * u[0] + ds[0],
+                    model.crank_radius * u[1] + ds[1],
+                ]
+            })
+            .collect();
+        let ecc_radius: Vec<f64> = (0..n)
+            .map(|i| model.eccentricity + errs.crank_eccentricity.get(i).copied().unwrap_or(0.0))
+            .collect();
+        let ecc_phase: Vec<f64> = (0..n)
+            .map(|i| errs.crank_phase.get(i).copied().unwrap_or(0.0))
+            .collect();
         let pressure = scene.stage1.as_ref().map_or([0.0, 1.0], |s| {
             let (s, c) = s.pressure_angle.sin_cos();
             [s, c]
@@ -316,6 +350,9 @@ impl Statics {
             pin_law,
             mesh_law,
             seats,
+            seat_vecs,
+            ecc_radius,
+            ecc_phase,
             holes,
             pressure,
             unknowns,
@@ -426,9 +463,9 @@ impl Statics {
         let u0 = cos_sin(thc);
         for i in 0..self.cranks {
             let ci = self.crank_index(i);
-            let s = rotate(u0, self.seats[i]);
-            x[ci] = m.crank_radius * s[0];
-            x[ci + 1] = m.crank_radius * s[1];
+            let s = rotate(u0, self.seat_vecs[i]);
+            x[ci] = s[0];
+            x[ci + 1] = s[1];
             x[ci + 2] = psi;
         }
         for (k, d) in m.discs.iter().enumerate() {
@@ -492,9 +529,9 @@ impl Statics {
                     let u0 = cos_sin(x[CARRIER]);
                     for i in 0..self.cranks {
                         let ci = self.crank_index(i);
-                        let s = rotate(u0, self.seats[i]);
-                        x[ci] = m.crank_radius * s[0];
-                        x[ci + 1] = m.crank_radius * s[1];
+                        let s = rotate(u0, self.seat_vecs[i]);
+                        x[ci] = s[0];
+                        x[ci + 1] = s[1];
                     }
                 }
             }
@@ -728,7 +765,6 @@ impl Statics {
         }
         let thc = x[CARRIER];
         let u0 = cos_sin(thc);
-        let e = m.eccentricity;
         for i in 0..self.cranks {
             let ci = self.crank_index(i);
             let u = rotate(u0, self.seats[i]);
@@ -799,12 +835,14 @@ impl Statics {
                         .push(rot - dot(dcr, [sp * u[0] + cp * zu[0], sp * u[1] + cp * zu[1]]));
                 }
             }
-            // Crank bearing: d = p - s(th_c).
+            // Crank bearing: d = p - s_act(th_c) (the actual seat, with its error).
             if let Some(cb) = self
                 .crank_bearing
                 .as_ref()
                 .filter(|_| on(Family::CrankBearings))
             {
+                let s = rotate(u0, self.seat_vecs[i]);
+                let dcr = [p[0] - s[0], p[1] - s[1]];
                 let (g, h) = cb.static_tangent(dcr);
                 // J_d: p -> I, th_c -> -perp(s).
                 let ps = perp(s);
@@ -832,7 +870,8 @@ impl Statics {
                 for (k, disc) in m.discs.iter().enumerate() {
                     let dk = self.disc_index(k);
                     let ecc = {
-                        let c = cos_sin(alpha + disc.phase);
+                        let c = cos_sin(alpha + disc.phase + self.ecc_phase[i]);
+                        let e = self.ecc_radius[i];
                         [e * c[0], e * c[1]]
                     };
                     let arm = rotate(cos_sin(x[dk + 2]), self.holes[i * nd + k]);
@@ -908,10 +947,7 @@ impl Statics {
         }
         let thc = x[CARRIER];
         let u0 = cos_sin(thc);
-        let seat = |i: usize| {
-            let u = rotate(u0, self.seats[i]);
-            [m.crank_radius * u[0], m.crank_radius * u[1]]
-        };
+        let seat = |i: usize| rotate(u0, self.seat_vecs[i]);
         let slaved_cranks = match self.kind {
             Kind::Rigid => true,
             Kind::Compliant => self.crank_bearing.is_none(),
@@ -1225,7 +1261,28 @@ mod tests {
         out.push(pe.clone());
         pe.joints = crate::dynamics::compliant::default_joints();
         out.push(pe);
+        // Assembly errors (compliant joints only), with compliant and rigid crank bearings.
+        let mut ae = c.clone();
+        with_assembly_errors(&mut ae);
+        out.push(ae.clone());
+        if let Joints::Compliant { crank_bearing, .. } = &mut ae.joints {
+            *crank_bearing = None;
+        }
+        out.push(ae);
         out
+    }
+
+    /// Assembly errors of a few um (and a few 1e-4 rad of phase) on every crank, hole and seat.
+    fn with_assembly_errors(s: &mut Scene) {
+        let n = s.cranks as usize;
+        let nd = s.discs.len();
+        let e = &mut s.errors;
+        e.crank_eccentricity = (0..n).map(|i| 2e-6 * (i as f64 - 0.7)).collect();
+        e.crank_phase = (0..n).map(|i| 3e-4 * (1.0 - i as f64)).collect();
+        e.disc_holes = (0..n * nd)
+            .map(|j| [1e-6 * (j as f64 - 2.0), -1.5e-6 + 0.7e-6 * j as f64])
+            .collect();
+        e.carrier_seats = (0..n).map(|i| [-2e-6 + 1e-6 * i as f64, 1.5e-6]).collect();
     }
 
     /// Disc profile errors of a few um on both discs: harmonics of several orders and a
@@ -1266,6 +1323,10 @@ mod tests {
         out.push(pe);
         with_profile_errors(&mut r);
         out.push(r);
+        // Roller bearings with assembly errors.
+        let mut ae = base.clone();
+        with_assembly_errors(&mut ae);
+        out.push(ae);
         out
     }
 
