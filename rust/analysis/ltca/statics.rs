@@ -1286,14 +1286,17 @@ mod tests {
     }
 
     /// Disc profile errors of a few um on both discs: harmonics of several orders and a
-    /// periodic table on disc 0.
+    /// periodic table on disc 0. The 1 um waviness of order 400 on disc 1 makes the
+    /// `delta'' grad phi grad phi^T` term of the tangent visible to the central-difference
+    /// test (without it that test fails at 5e-6 > 1e-6; at the lower orders the term is
+    /// ~1e-6 of the contact stiffness).
     fn with_profile_errors(s: &mut Scene) {
         s.discs[0].profile_error = Some(ProfileError {
             harmonics: vec![[3e-6, 23.0, 0.4], [2e-6, 2.0, 1.0]],
             table: vec![[0.0, 1e-6], [2.0, -1e-6], [4.0, 5e-7]],
         });
         s.discs[1].profile_error = Some(ProfileError {
-            harmonics: vec![[2e-6, 46.0, 1.3], [1e-6, 1.0, 0.0]],
+            harmonics: vec![[2e-6, 46.0, 1.3], [1e-6, 1.0, 0.0], [1e-6, 400.0, 0.2]],
             table: vec![],
         });
     }
