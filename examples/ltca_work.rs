@@ -11,9 +11,10 @@
 //! paper scene with compliant bearings and the Palmgren line law, as `benches/ltca.rs`) and
 //! WORKLOAD `warm` (N warm crank angles with the full report, 1/360 of the period apart),
 //! `period` (N sweeps of 360 crank angles over the mesh period with full reports), `bare` (N
-//! sweeps of 360 equilibria without reports, as the transmission error) or `loop` (N
-//! 200-point torque-twist loops at crank angle 0). Prints the Newton iterations and force
-//! evaluations used.
+//! transmission errors at 360 crank angles: four sweeps of equilibria without reports, loaded and
+//! unloaded in both directions) or `loop` (N 200-point torque-twist loops at crank angle 0).
+//! Prints the Newton iterations and force evaluations used, and with `LTCA_WORK_RESULTS` set
+//! the results (for A/B comparisons of the same workload).
 use rvdyn::analysis::ltca::Ltca;
 use rvdyn::dynamics::compliant::default_joints;
 use rvdyn::dynamics::scene::{ContactLawSpec, Scene};
@@ -52,9 +53,21 @@ fn ltca_work(
             for _ in 0..n {
                 ltca.reset();
                 let pts = ltca.sweep(black_box(torque), angles)?;
-                if std::env::var_os("LTCA_WORK_ITERS").is_some() {
-                    let it: Vec<usize> = pts.iter().map(|p| p.iterations).collect();
-                    println!("{it:?}");
+                if std::env::var_os("LTCA_WORK_RESULTS").is_some() {
+                    let te: Vec<f64> = pts.iter().map(|p| p.transmission_error).collect();
+                    let peak = pts.iter().map(|p| p.peak_pin_force()).fold(0.0, f64::max);
+                    let k: Vec<f64> = pts.iter().map(|p| p.torsional_stiffness).collect();
+                    let gaps: f64 = pts
+                        .iter()
+                        .flat_map(|p| p.pins.iter().flatten().map(|l| l.gap))
+                        .sum();
+                    println!(
+                        "TE p-p {:.15e} rad, peak pin force {peak:.15e} N, TE[0..3] {:?}, \
+                         stiffness[0..2] {:?}, sum of gaps {gaps:.15e} m",
+                        rvdyn::analysis::ltca::peak_to_peak(&te),
+                        &te[..3],
+                        &k[..2]
+                    );
                 }
                 iterations += pts.iter().map(|p| p.iterations).sum::<usize>();
             }
@@ -62,12 +75,30 @@ fn ltca_work(
         "bare" => {
             for _ in 0..n {
                 let te = ltca.transmission_error(black_box(torque), 1e-6 * torque, 360, 0.0)?;
+                if std::env::var_os("LTCA_WORK_RESULTS").is_some() {
+                    let pp = rvdyn::analysis::ltca::peak_to_peak;
+                    println!(
+                        "TE p-p fwd {:.15e} rev {:.15e} unloaded {:.15e} {:.15e} rad",
+                        pp(&te.forward),
+                        pp(&te.reverse),
+                        pp(&te.unloaded_forward),
+                        pp(&te.unloaded_reverse)
+                    );
+                }
                 black_box(te);
             }
         }
         "loop" => {
             for _ in 0..n {
-                black_box(ltca.twist_loop(black_box(torque), 0.0, 200)?);
+                let lp = ltca.twist_loop(black_box(torque), 0.0, 200)?;
+                if std::env::var_os("LTCA_WORK_RESULTS").is_some() {
+                    println!(
+                        "rigidity {:.15e} N m/rad, lost motion {:.15e} rad, backlash {:.15e} \
+                         rad, twist[100] {:.15e} rad, tangent[50] {:.15e}",
+                        lp.rigidity, lp.lost_motion, lp.backlash, lp.twist[100], lp.tangent_stiffness[50]
+                    );
+                }
+                black_box(lp);
             }
         }
         _ => return Err(format!("unknown workload {what}").into()),
