@@ -9,7 +9,8 @@
 //!
 //! `PRESET WORKLOAD N` with PRESET `physical` (`Scene::physical("rated")`) or `paper` (the
 //! paper scene with compliant bearings and the Palmgren line law, as `benches/ltca.rs`) and
-//! WORKLOAD `warm` (N warm crank angles with the full report, 1/360 of the period apart),
+//! WORKLOAD `warm` (N warm crank angles with the full report, 1/360 of the period apart), `cold`
+//! (N crank angles at 0.1 rad from the kinematic pose, as the bench's `one_crank_angle_cold`),
 //! `period` (N sweeps of 360 crank angles over the mesh period with full reports), `bare` (N
 //! transmission errors at 360 crank angles: four sweeps of equilibria without reports, loaded and
 //! unloaded in both directions) or `loop` (N 200-point torque-twist loops at crank angle 0).
@@ -47,6 +48,12 @@ fn ltca_work(
             for k in 1..=n {
                 let p = ltca.solve(black_box(torque), angles[k % angles.len()])?;
                 iterations += p.iterations;
+            }
+        }
+        "cold" => {
+            for _ in 0..n {
+                ltca.reset();
+                iterations += ltca.solve(black_box(torque), 0.1)?.iterations;
             }
         }
         "period" => {
@@ -95,7 +102,11 @@ fn ltca_work(
                     println!(
                         "rigidity {:.15e} N m/rad, lost motion {:.15e} rad, backlash {:.15e} \
                          rad, twist[100] {:.15e} rad, tangent[50] {:.15e}",
-                        lp.rigidity, lp.lost_motion, lp.backlash, lp.twist[100], lp.tangent_stiffness[50]
+                        lp.rigidity,
+                        lp.lost_motion,
+                        lp.backlash,
+                        lp.twist[100],
+                        lp.tangent_stiffness[50]
                     );
                 }
                 black_box(lp);

@@ -339,7 +339,10 @@ fn bench_reference_errors() {
         max_damping: 1e5,
         damping_depth: 1e-5,
     };
-    for (name, s) in [("paper", paper), ("physical", Scene::physical("rated").unwrap())] {
+    for (name, s) in [
+        ("paper", paper),
+        ("physical", Scene::physical("rated").unwrap()),
+    ] {
         println!("{name}:");
         reference_errors(&s, s.load.torque(0.0));
     }
@@ -431,7 +434,10 @@ fn cpu_time_report() {
         max_damping: 1e5,
         damping_depth: 1e-5,
     };
-    for (name, s) in [("paper", paper), ("physical", Scene::physical("rated").unwrap())] {
+    for (name, s) in [
+        ("paper", paper),
+        ("physical", Scene::physical("rated").unwrap()),
+    ] {
         let rated = s.load.torque(0.0);
         print!("{name}: ");
         cpu_times(&s, rated, cpu);
@@ -713,7 +719,10 @@ fn report_equals_a_fresh_evaluation_at_the_solution() {
                         .zip(b.iter().flatten())
                         .all(|(x, y)| (x - y).abs() <= 1e-9 * m)
             };
-            assert!(close(&p.eccentric_bearing_force, &cs.eccentric_bearing_force));
+            assert!(close(
+                &p.eccentric_bearing_force,
+                &cs.eccentric_bearing_force
+            ));
             assert!(close(&p.crank_bearing_force, &cs.crank_bearing_force));
             let mesh = cs.mesh_force.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             for (a, b) in p.mesh_force.iter().zip(&cs.mesh_force) {
