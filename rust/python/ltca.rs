@@ -115,17 +115,22 @@ impl LtcaSolver {
         Ok(d)
     }
 
-    /// The torque-twist loop at `crank_angle` [rad] over +-`rated` [N m] with `points` points.
+    /// The torque-twist loop at `crank_angle` [rad] over +-`rated` [N m] with `points` points;
+    /// `friction`: apply the scene's friction (if it has any).
+    #[pyo3(signature = (rated, crank_angle, points, friction = true))]
     fn twist_loop<'py>(
         &mut self,
         py: Python<'py>,
         rated: f64,
         crank_angle: f64,
         points: usize,
+        friction: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
-        let lp = py.detach(|| ltca.twist_loop(rated, crank_angle, points))?;
+        let applied = friction && ltca.friction_laws().any();
+        let lp = py.detach(|| ltca.twist_loop_with(rated, crank_angle, points, friction))?;
         let d = PyDict::new(py);
+        d.set_item("friction", applied)?;
         let n = lp.torque.len();
         d.set_item("torque", f64_array(py, lp.torque, vec![n])?)?;
         d.set_item("twist", f64_array(py, lp.twist, vec![n])?)?;

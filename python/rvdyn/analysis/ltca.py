@@ -224,6 +224,28 @@ class TwistLoop:
     rigidity: float
     lost_motion: float
     backlash: float
+    friction: bool = False
+
+    def branches(self) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
+        """The loop's upper (unloading, ``+rated -> -rated``) and lower (loading, ``-rated ->
+        +rated``: the last quarter, then the first) branches as ``(torque, twist)`` pairs with
+        increasing torque. Without friction both are the same curve."""
+        n = self.torque.size
+        i_max = int(np.argmax(self.torque))
+        i_min = int(np.argmin(self.torque))
+        up_t, up_w = self.torque[i_max:i_min + 1][::-1], self.twist[i_max:i_min + 1][::-1]
+        lo_t = np.concatenate([self.torque[i_min:n], self.torque[1:i_max + 1]])
+        lo_w = np.concatenate([self.twist[i_min:n], self.twist[1:i_max + 1]])
+        return (up_t, up_w), (lo_t, lo_w)
+
+    def width(self, torque: float) -> float:
+        """Twist width of the loop [rad] at ``torque`` [N m] (upper minus lower branch,
+        linear interpolation between the loop's points); the friction's hysteresis."""
+        (ut, uw), (lt, lw) = self.branches()
+        t = float(torque)
+        if not (np.isfinite(t) and abs(t) <= self.rated_torque):
+            raise ParameterError(f"torque must be within +-rated ({self.rated_torque} N m), got {torque}")
+        return float(np.interp(t, ut, uw) - np.interp(t, lt, lw))
 
     def summary(self) -> dict[str, float]:
         """Rigidity [N m/arcmin], lost motion and backlash [arcmin]."""
@@ -302,14 +324,17 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int = 
 
 
 def torque_twist(scene: Scene, rated_torque: float | None = None, crank_angle: float = 0.0,
-                 points: int = 201) -> TwistLoop:
+                 points: int = 201, *, friction: bool = True) -> TwistLoop:
     """The torque-twist loop 0 -> +rated -> -rated -> 0 at ``crank_angle`` [rad] with the input
-    held, with rigidity, lost motion and backlash (catalogue definitions)."""
+    held, with rigidity, lost motion and backlash (catalogue definitions). With the scene's
+    friction (``scene.friction``; ``friction=False`` ignores it) the loop opens: quasi-static
+    Coulomb sliding at pins, teeth and joint bearings, sticking at each reversal
+    (docs/model.md, "Friction in the LTCA")."""
     sc = _scene(scene)
     t = abs(_rated(sc, rated_torque))
     d = _core.LtcaSolver(sc._compiled, 1e-12).twist_loop(t, _float("crank_angle", crank_angle, "rad"),
-                                                         int(points))
+                                                         int(points), bool(friction))
     return TwistLoop(crank_angle=float(crank_angle), rated_torque=t, torque=d["torque"],
                      twist=d["twist"], tangent_stiffness=d["tangent_stiffness"],
                      rigidity=float(d["rigidity"]), lost_motion=float(d["lost_motion"]),
-                     backlash=float(d["backlash"]))
+                     backlash=float(d["backlash"]), friction=bool(d["friction"]))

@@ -523,6 +523,8 @@ impl Ltca {
         let mut solved: Vec<(f64, Vec<f64>)> = Vec::with_capacity(points);
         let mut direction = 1.0;
         let mut held: Option<f64> = None;
+        // (torque solved, direction, twist) of every loop point.
+        let mut branch: Vec<(f64, f64, f64)> = Vec::with_capacity(points);
         for (i, &t) in torque.iter().enumerate() {
             if i > 0 {
                 let d = (t - torque[i - 1]).signum();
@@ -537,12 +539,39 @@ impl Ltca {
                 side = t.signum();
             }
             let near = (t == 0.0).then_some(rated);
-            let slide = self.friction_twist(laws, ts, psi, direction, near)?;
+            let tw = match self.friction_twist(laws, ts, psi, direction, near) {
+                Ok(slide) => stick(held, direction, slide),
+                // Near zero torque a load-independent friction (the bearings' M0) can exceed
+                // the load and what the elastic forces can overcome: no sliding equilibrium
+                // exists, the contacts stick and the twist is held.
+                // Then the contacts stick where the sliding branch ends: continuation from the
+                // previous point's torque down by factors of 10, the last sliding twist held.
+                Err(_) if t == 0.0 && !twist.is_empty() => {
+                    let mut tw = twist[twist.len() - 1];
+                    let mut level = 0.1 * torque[i - 1].abs();
+                    while level > eps {
+                        match self.friction_twist(laws, level * ts.signum(), psi, direction, None) {
+                            Ok(v) => tw = stick(held, direction, v),
+                            Err(_) => break,
+                        }
+                        level *= 0.1;
+                    }
+                    tw
+                }
+                // At the start, at rest: the frictionless equilibrium (no friction acts yet).
+                Err(_) if t == 0.0 => {
+                    let (q, _) = self.solve_near_zero(ts, psi, rated)?;
+                    let x = self.statics.full(psi, &q);
+                    -(x[CARRIER] + psi / self.statics.zc())
+                }
+                Err(e) => return Err(e),
+            };
             if let Some(l) = &self.last {
                 solved.push((ts, l.q.clone()));
             }
             tangent.push(self.last_tangent_stiffness());
-            twist.push(stick(held, direction, slide));
+            twist.push(tw);
+            branch.push((ts, direction, tw));
         }
         // Catalogue points on the sliding branches (each warm-started from the loop point
         // nearest in torque on the same side of zero), with the stick at the loop's tips.
@@ -560,7 +589,17 @@ impl Ltca {
                 });
             }
             let near = (t.abs() < 1e-6 * rated).then_some(rated);
-            self.friction_twist(laws, t, psi, d, near)
+            match self.friction_twist(laws, t, psi, d, near) {
+                Ok(v) => Ok(v),
+                // Stuck near zero torque (see above): the loop's own twist there.
+                Err(e) => branch
+                    .iter()
+                    .filter(|(s, dd, _)| *dd == d && s.signum() == t.signum())
+                    .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+                    .filter(|_| near.is_some())
+                    .map(|b| b.2)
+                    .ok_or(e),
+            }
         };
         let tip_plus = at(rated, 1.0)?;
         let tip_minus = at(-rated, -1.0)?;
