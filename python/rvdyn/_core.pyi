@@ -489,6 +489,8 @@ class LtcaSolver:
     def twist_loop(self, rated: float, crank_angle: float, points: int, friction: bool = True) -> dict[str, Any]:
         """Torque-twist loop with rigidity, lost motion and backlash (with the scene's friction
         unless ``friction`` is false)."""
+    def friction_sweep(self, torque: float, crank_angles: list[float]) -> dict[str, Any]:
+        """Running sweep with the scene's friction: TE [rad] and input torque [N m]."""
 
 # ---- vibration analyses (rust/python/modal.rs) ------------------------------------------------
 

@@ -143,6 +143,31 @@ impl LtcaSolver {
         d.set_item("backlash", lp.backlash)?;
         Ok(d)
     }
+
+    /// A running sweep with the scene's friction at `crank_angles` [rad] under the output
+    /// torque `torque` [N m] (the input driving against it): TE [rad] and the held input's
+    /// torque [N m] per crank angle.
+    fn friction_sweep<'py>(
+        &mut self,
+        py: Python<'py>,
+        torque: f64,
+        crank_angles: Vec<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
+        let laws = ltca.friction_laws().clone();
+        let r = py.detach(|| ltca.friction_sweep(&laws, torque, &crank_angles))?;
+        let n = r.len();
+        let d = PyDict::new(py);
+        d.set_item(
+            "transmission_error",
+            f64_array(py, r.iter().map(|p| p.0).collect(), vec![n])?,
+        )?;
+        d.set_item(
+            "input_torque",
+            f64_array(py, r.iter().map(|p| p.1).collect(), vec![n])?,
+        )?;
+        Ok(d)
+    }
 }
 
 impl LtcaSolver {

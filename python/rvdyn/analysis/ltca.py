@@ -17,7 +17,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["ARCMIN", "ARCSEC", "LtcaResult", "TransmissionError", "TwistLoop", "ltca",
+__all__ = ["ARCMIN", "ARCSEC", "LtcaResult", "TransmissionError", "TwistLoop", "ltca", "running_friction",
            "torque_twist", "transmission_error"]
 
 #: One arc minute and one arc second [rad].
@@ -338,3 +338,28 @@ def torque_twist(scene: Scene, rated_torque: float | None = None, crank_angle: f
                      twist=d["twist"], tangent_stiffness=d["tangent_stiffness"],
                      rigidity=float(d["rigidity"]), lost_motion=float(d["lost_motion"]),
                      backlash=float(d["backlash"]), friction=bool(d["friction"]))
+
+
+def running_friction(scene: Scene, torque: float | None = None, points: int = 24, *,
+                     start: float = 0.0) -> dict[str, np.ndarray | float]:
+    """Quasi-static running sweeps with the scene's friction over one mesh period at ``points``
+    crank angles: every contact slides as in the running reducer, the input driving against
+    ``+torque`` (forward) and ``-torque`` (reverse) [N m]. Returns ``crank_angle`` [rad], TE
+    ``forward`` / ``reverse`` [rad], the held input's torque ``input_forward`` /
+    ``input_reverse`` [N m] and the mean quasi-static ``efficiency`` ``T / (i T_in)`` of each
+    direction (docs/model.md, "Friction in the LTCA")."""
+    sc = _scene(scene)
+    t = abs(_rated(sc, torque))
+    if int(points) < 1:
+        raise ParameterError(f"points must be at least 1, got {points}")
+    solver = _core.LtcaSolver(sc._compiled, 1e-12)
+    period = float(solver.mesh_period)
+    angles = _float("start", start, "rad") + period * np.arange(int(points)) / int(points)
+    fwd = solver.friction_sweep(t, angles.tolist())
+    rev = solver.friction_sweep(-t, angles.tolist())
+    i = float(solver.ratio)
+    return {"crank_angle": angles, "forward": fwd["transmission_error"],
+            "reverse": rev["transmission_error"], "input_forward": fwd["input_torque"],
+            "input_reverse": rev["input_torque"],
+            "efficiency_forward": float(np.mean(t / (i * fwd["input_torque"]))),
+            "efficiency_reverse": float(np.mean(-t / (i * rev["input_torque"])))}

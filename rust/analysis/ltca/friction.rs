@@ -378,13 +378,29 @@ impl Ltca {
         direction: f64,
         near_zero: Option<f64>,
     ) -> Result<(Vec<f64>, NewtonReport)> {
-        let (mut q, _) = match near_zero {
+        let (q, _) = match near_zero {
             Some(rated) => self.solve_near_zero(torque, psi, rated)?,
             None => self.solve_unknowns(torque, psi)?,
         };
         let e0 = self.eval_friction(laws, psi, torque, &q, None)?;
         let dir = self.branch_rate(psi, &q, &e0.k, direction)?;
-        let slip = Slip::new(&self.statics, &e0.cs, dir);
+        let (q, rep, _) = self.newton_friction(laws, torque, psi, q, &e0.cs, dir)?;
+        Ok((q, rep))
+    }
+
+    /// The equilibrium at `torque` and crank angle `psi` with friction sliding along the full
+    /// coordinate rate `dir`, by Newton from `q` (whose contact state is `cs0`). Returns the
+    /// unknowns, the report and the torque the held input carries [N m] (friction included).
+    fn newton_friction(
+        &mut self,
+        laws: &FrictionLaws,
+        torque: f64,
+        psi: f64,
+        mut q: Vec<f64>,
+        cs0: &ContactState,
+        dir: Vec<f64>,
+    ) -> Result<(Vec<f64>, NewtonReport, f64)> {
+        let slip = Slip::new(&self.statics, cs0, dir);
         let n = q.len();
         let scale = self.statics.scale.clone();
         let rp = scale[0];
@@ -467,6 +483,30 @@ impl Ltca {
                 return Err(not_converged(psi, torque, rmax / load.max(1.0), it));
             }
         }
+        // The held input's torque: the reaction of the elastic and the friction forces on it.
+        let ev = self.eval_friction(laws, psi, torque, &q, Some(&slip))?;
+        let x = self.statics.full(psi, &q);
+        let mut qf = vec![0.0; x.len()];
+        friction_forces(laws, &self.statics, &x, &ev.cs, &slip, &mut qf);
+        let st = &self.statics;
+        let input_torque = if st.model.mesh.is_some() {
+            st.input_reaction(&self.work) - qf[SUN]
+        } else if st.kind == Kind::Rigid {
+            // Rigid joints, cranks held: the disc centres ride on the eccentrics,
+            // dO_k/dpsi = z x O_k; the input carries minus the forces' virtual work on them.
+            -(0..st.model.discs.len())
+                .map(|k| {
+                    let dk = st.disc_index(k);
+                    let f = [self.work.qf[dk] + qf[dk], self.work.qf[dk + 1] + qf[dk + 1]];
+                    -f[0] * x[dk + 1] + f[1] * x[dk]
+                })
+                .sum::<f64>()
+        } else {
+            st.input_reaction(&self.work)
+                - (0..st.cranks)
+                    .map(|i| qf[st.crank_index(i) + 2])
+                    .sum::<f64>()
+        };
         // The frictionless tangent at the frictional pose (the reported tangent stiffness);
         // the warm start stays the frictionless sequence.
         self.work.k_last = ev.k;
@@ -476,7 +516,48 @@ impl Ltca {
                 iterations: it,
                 residual: rmax / load.max(1.0),
             },
+            input_torque,
         ))
+    }
+
+    /// Equilibria along a running sweep with friction: at each crank angle in turn, under the
+    /// output torque `torque`, with every contact sliding as the running reducer slides (the
+    /// kinematic rate of the full coordinates per crank angle, the input driving against the
+    /// load: the crank angle decreasing for `torque > 0`, increasing for `torque < 0`). Returns
+    /// per crank angle the transmission error [rad] and the torque the held input carries
+    /// [N m]; with the ratio `i`, `torque / (i input_torque)` is the quasi-static efficiency.
+    pub fn friction_sweep(
+        &mut self,
+        laws: &FrictionLaws,
+        torque: f64,
+        crank_angles: &[f64],
+    ) -> Result<Vec<(f64, f64)>> {
+        crate::error::require_finite("torque", torque)?;
+        // The load acts against positive carrier rotation and the carrier turns by
+        // `-psi / zc`: the input drives it against a positive torque with psi decreasing.
+        let drive = if torque < 0.0 { 1.0 } else { -1.0 };
+        let mut out = Vec::with_capacity(crank_angles.len());
+        for &psi in crank_angles {
+            let (q, _) = self.solve_unknowns(torque, psi)?;
+            let h = 1e-6;
+            let xp = self.statics.kinematic_full(psi + h);
+            let xm = self.statics.kinematic_full(psi - h);
+            let dir: Vec<f64> = xp
+                .iter()
+                .zip(&xm)
+                .map(|(a, b)| drive * (a - b) / (2.0 * h))
+                .collect();
+            let e0 = self.eval_friction(laws, psi, torque, &q, None)?;
+            let (q, _, input) = self.newton_friction(laws, torque, psi, q, &e0.cs, dir)?;
+            let x = self.statics.full(psi, &q);
+            let held = if self.statics.model.mesh.is_some() {
+                self.statics.held_input(psi)
+            } else {
+                psi
+            };
+            out.push((x[CARRIER] - held / self.ratio, input));
+        }
+        Ok(out)
     }
 }
 
