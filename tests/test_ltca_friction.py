@@ -11,7 +11,7 @@ import pytest
 
 import rvdyn
 from rvdyn.analysis import torque_twist
-from rvdyn.analysis.ltca import running_friction
+from rvdyn.analysis import running_friction
 from rvdyn.errors import ParameterError, SceneError
 
 RATED = 43_921.3
@@ -97,9 +97,9 @@ def test_running_efficiency_against_the_analytic_estimate() -> None:
     eta_est = (1.0 - mu * 0.1748 * (1.0 - 1.0 / i)) / (1.0 + l_pin)
     r = running_friction(rvdyn.Scene.paper("rated", friction={"pin": mu, "mesh": mu}), RATED, 24)
     for key in ("efficiency_forward", "efficiency_reverse"):
-        eta = float(r[key])  # type: ignore[arg-type]
+        eta = float(r[key])
         assert (1.0 - eta) == pytest.approx(1.0 - eta_est, rel=0.10), (key, eta, eta_est)
     free = running_friction(rvdyn.Scene.paper("rated"), RATED, 24)
-    assert float(free["efficiency_forward"]) == pytest.approx(1.0, abs=1e-5)  # type: ignore[arg-type]
+    assert float(free["efficiency_forward"]) == pytest.approx(1.0, abs=1e-5)
     # Friction shifts the TE of both drive directions apart (more lost motion).
     assert np.mean(r["reverse"]) - np.mean(r["forward"]) > np.mean(free["reverse"]) - np.mean(free["forward"])

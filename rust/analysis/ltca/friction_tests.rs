@@ -1,7 +1,7 @@
 //! Tests of the quasi-static friction of the LTCA (module `friction`).
 
 use super::*;
-use crate::analysis::ltca::{ARCMIN, LtcaPoint};
+use crate::analysis::ltca::LtcaPoint;
 use crate::dynamics::scene::Friction;
 
 fn rated() -> f64 {
@@ -245,58 +245,4 @@ fn running_efficiency_is_the_power_balance_of_the_sliding() {
         etas.push(eta);
     }
     assert!((etas[0] - etas[1]).abs() < 1e-9, "{etas:?}");
-}
-
-#[test]
-#[ignore]
-fn explore_efficiency() {
-    for mu in [0.0, 0.05] {
-        let s = with_friction(single_stage(), mu, 0.0);
-        let laws = FrictionLaws::new(&s);
-        let mut ltca = Ltca::new(&s).unwrap();
-        let i = ltca.ratio();
-        for t in [rated(), -rated()] {
-            let r = ltca.friction_sweep(&laws, t, &[0.0, 0.1, 0.2]).unwrap();
-            for (te, tin) in r {
-                println!(
-                    "mu {mu} T {t}: ratio {i} te {te:e} input {tin} eta {}",
-                    t / (i * tin)
-                );
-            }
-        }
-    }
-}
-
-#[test]
-#[ignore]
-fn explore() {
-    for (name, scene) in [
-        ("physical", Scene::physical("rated").unwrap()),
-        ("paper", Scene::paper("rated").unwrap()),
-    ] {
-        let s = with_friction(scene, 0.05, 0.05);
-        let mut ltca = Ltca::new(&s).unwrap();
-        let t0 = std::time::Instant::now();
-        let lp0 = ltca.twist_loop_with(rated(), 0.0, 41, false).unwrap();
-        let t1 = t0.elapsed();
-        let lp = ltca.twist_loop(rated(), 0.0, 41).unwrap();
-        let t2 = t0.elapsed();
-        println!("{name}: {t1:?} {t2:?}");
-        for (a, b) in [(&lp0, "frictionless"), (&lp, "friction")] {
-            println!(
-                "{b}: rigidity {:.1} Nm/arcmin, lost motion {:.4} arcmin, backlash {:.4} arcmin",
-                a.rigidity * ARCMIN,
-                a.lost_motion / ARCMIN,
-                a.backlash / ARCMIN
-            );
-        }
-        for i in 0..41 {
-            println!(
-                "{:10.1} {:10.5} {:10.5}",
-                lp.torque[i],
-                lp0.twist[i] / ARCMIN,
-                lp.twist[i] / ARCMIN
-            );
-        }
-    }
 }
