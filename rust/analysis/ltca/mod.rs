@@ -12,6 +12,7 @@
 //! `T` is the forward drive.
 
 pub mod export;
+pub mod friction;
 pub mod newton;
 pub mod statics;
 
@@ -177,6 +178,8 @@ pub struct Ltca {
     face_width: f64,
     ratio: f64,
     mesh_period: f64,
+    /// The scene's friction (as the dynamic models apply it; `friction`).
+    friction: friction::FrictionLaws,
 }
 
 impl Ltca {
@@ -206,6 +209,7 @@ impl Ltca {
             face_width: scene.cycloid.face_width,
             ratio: scene.ratio(),
             mesh_period: mesh_period(scene),
+            friction: friction::FrictionLaws::new(scene),
             statics,
         })
     }
@@ -555,8 +559,29 @@ impl Ltca {
 
     /// The torque-twist loop at crank angle `psi`: `points` torques along
     /// 0 -> +rated -> -rated -> 0 with rigidity, lost motion and backlash (catalogue
-    /// definitions, docs/model.md).
+    /// definitions, docs/model.md), with the scene's friction if it has any.
     pub fn twist_loop(&mut self, rated: f64, psi: f64, points: usize) -> Result<TwistLoop> {
+        self.twist_loop_with(rated, psi, points, true)
+    }
+
+    /// The scene's friction laws as the LTCA applies them.
+    pub fn friction_laws(&self) -> &friction::FrictionLaws {
+        &self.friction
+    }
+
+    /// As [`Ltca::twist_loop`]; `friction = false` ignores the scene's friction (the closed
+    /// loop of the frictionless reducer).
+    pub fn twist_loop_with(
+        &mut self,
+        rated: f64,
+        psi: f64,
+        points: usize,
+        friction: bool,
+    ) -> Result<TwistLoop> {
+        if friction && self.friction.any() {
+            let laws = self.friction.clone();
+            return self.twist_loop_with_friction(&laws, rated, psi, points);
+        }
         require_finite("rated torque", rated)?;
         let rated = rated.abs();
         if rated == 0.0 || points < 8 {

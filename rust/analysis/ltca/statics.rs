@@ -1042,6 +1042,14 @@ impl Statics {
         Ok(())
     }
 
+    /// `out = J^T v` of a full-coordinate force `v` with the map Jacobian of the last
+    /// [`Statics::eval`] (the friction forces of `ltca::friction`).
+    pub fn reduce_force(&self, v: &[f64], work: &Work, out: &mut [f64]) {
+        for (o, col) in out.iter_mut().zip(&work.jac) {
+            *o = col.iter().map(|&(i, c)| c * v[i]).sum();
+        }
+    }
+
     /// `J^T A J` of a full-coordinate matrix `a` with the map Jacobian of the last
     /// [`Statics::eval`] (velocities map linearly: no curvature terms).
     pub fn reduce(&self, a: &Dense, work: &Work) -> Dense {
