@@ -91,40 +91,68 @@ def summarize(load: str, scene: Scene, result: Result, wall: float) -> dict[str,
     }
 
 
-def envelope(x: np.ndarray, y: np.ndarray, buckets: int) -> tuple[np.ndarray, np.ndarray]:
-    """The trace ``(x, y)`` reduced to its minimum and maximum in each of ``buckets`` equal runs
-    of samples, in their order of occurrence: drawn at a width of ``buckets`` pixels or fewer
-    it covers the same pixels as the full trace (every extreme is kept), with at most
-    ``2 buckets`` points. Traces already that short are returned unchanged. For ``x`` in
-    increasing order (a time axis); ``x`` and ``y`` of the same length."""
-    n = len(x)
-    if n <= 2 * buckets:
-        return x, y
-    edges = np.linspace(0, n, buckets + 1).astype(int)
-    starts, lengths = edges[:-1], np.diff(edges)
-    cols = np.arange(int(lengths.max()))
-    # One row per bucket; the shorter buckets are padded with their own first sample, which
-    # leaves both extremes and their first occurrence (numpy's argmin/argmax) as they are.
-    rows = np.where(cols < lengths[:, None], starts[:, None] + cols, starts[:, None])
-    values = y[rows]
-    lo = starts + np.argmin(values, axis=1)
-    hi = starts + np.argmax(values, axis=1)
-    idx = np.stack([np.minimum(lo, hi), np.maximum(lo, hi)], axis=1).ravel()
+def _m4(x: np.ndarray, y: np.ndarray, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The first, smallest, largest and last sample of each run ``edges[k]:edges[k+1]`` (runs not
+    empty, ``edges`` from 0 to ``len(y)``), in their order, each sample once; the first
+    occurrence of a tied extreme, as numpy's argmin/argmax. ``y`` finite."""
+    starts, ends = edges[:-1], edges[1:]
+    lengths = ends - starts
+    run = np.repeat(np.arange(len(starts)), lengths)
+
+    def first(mask: np.ndarray) -> np.ndarray:
+        hits = np.flatnonzero(mask)
+        owner = run[hits]
+        return hits[np.concatenate(([True], owner[1:] != owner[:-1]))]
+
+    lo = first(y == np.repeat(np.minimum.reduceat(y, starts), lengths))
+    hi = first(y == np.repeat(np.maximum.reduceat(y, starts), lengths))
+    picks = np.stack([starts, lo, hi, ends - 1], axis=1)
+    picks.sort(axis=1)
+    idx = picks.ravel()
+    idx = idx[np.concatenate(([True], idx[1:] != idx[:-1]))]  # a sample picked twice is kept once
     return x[idx], y[idx]
+
+
+def envelope(x: np.ndarray, y: np.ndarray, buckets: int) -> tuple[np.ndarray, np.ndarray]:
+    """The trace ``(x, y)`` reduced to the first, last, smallest and largest sample of each of
+    ``buckets`` equal runs of samples, in their order of occurrence (the M4 aggregation of
+    Jugel et al. 2014), at most ``4 buckets`` points. Traces already that short, or holding a
+    value that is not finite, are returned unchanged. The figures use :func:`pixel_envelope`,
+    the same with one run per pixel column."""
+    n = len(x)
+    if n <= 4 * buckets or not np.all(np.isfinite(y)):
+        return x, y
+    return _m4(x, y, np.linspace(0, n, buckets + 1).astype(int))
+
+
+def pixel_envelope(x: np.ndarray, y: np.ndarray, px: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The trace ``(x, y)`` reduced to the first, last, smallest and largest sample in each pixel
+    column, ``px`` being the samples' horizontal pixel coordinates (increasing): drawn, it
+    covers the same pixels as the full trace, since within a column the full trace spans
+    exactly its smallest to its largest value and the segments joining neighbouring columns
+    are the trace's own (M4 aggregation, Jugel et al. 2014). At most 4 points per column;
+    returned unchanged where that saves nothing or a value is not finite."""
+    col = np.floor(px)
+    edges = np.concatenate(([0], np.flatnonzero(col[1:] != col[:-1]) + 1, [len(x)]))
+    if len(x) <= 4 * (len(edges) - 1) or not (np.all(np.isfinite(y)) and np.all(np.isfinite(col))):
+        return x, y
+    return _m4(x, y, edges)
 
 
 def _thin_lines(fig: Any) -> None:
     """Replace every long line of ``fig`` whose x increases (a trace against time) by its
-    per-pixel envelope at its axes' final width in pixels (call it after the layout). Lines
-    whose x goes back and forth (the disc centre's path) are drawn in full: an envelope by
-    sample runs would draw chords across them."""
+    per-pixel-column envelope (:func:`pixel_envelope`) at the axes' final place and limits:
+    call it after the layout, just before drawing. Lines whose x goes back and forth (the
+    disc centre's path) are drawn in full: an envelope of sample runs would cut chords
+    across them."""
     for ax in fig.axes:
         width = max(1, int(ax.bbox.width))
         for line in ax.get_lines():
             x, y = (np.asarray(v, dtype=float) for v in line.get_data())
-            if (len(x) > 2 * width and line.get_linestyle() not in ("None", "", " ")
+            if (len(x) > 4 * width and line.get_linestyle() not in ("None", "", " ")
                     and bool(np.all(np.diff(x) >= 0))):
-                line.set_data(*envelope(x, y, width))
+                px = line.get_transform().transform(np.column_stack([x, np.zeros_like(x)]))[:, 0]
+                line.set_data(*pixel_envelope(x, y, px))
 
 
 #: Resolution [dots per inch] of the figures.
