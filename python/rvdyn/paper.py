@@ -157,8 +157,8 @@ def _thin_lines(fig: Any) -> None:
 
 #: Resolution [dots per inch] of the figures.
 DPI = 110
-#: zlib level of the PNG files: 1 writes the same pixels as the default 6, about 4 times faster
-#: (the files are about 30 % larger).
+#: zlib level of the PNG files: 1 stores the same pixels as matplotlib's default 6 in about 60 %
+#: of the encoding time (20 instead of 33 ms for a 1320 x 440 figure; files about 30 % larger).
 PNG_COMPRESS_LEVEL = 1
 
 
