@@ -139,20 +139,29 @@ def pixel_envelope(x: np.ndarray, y: np.ndarray, px: np.ndarray) -> tuple[np.nda
     return _m4(x, y, edges)
 
 
-def _thin_lines(fig: Any) -> None:
-    """Replace every long line of ``fig`` whose x increases (a trace against time) by its
-    per-pixel-column envelope (:func:`pixel_envelope`) at the axes' final place and limits:
-    call it after the layout, just before drawing. Lines whose x goes back and forth (the
-    disc centre's path) are drawn in full: an envelope of sample runs would cut chords
-    across them."""
+def _long_traces(fig: Any) -> list[tuple[Any, np.ndarray, np.ndarray]]:
+    """The lines of ``fig`` worth thinning, with their data: traces against time (x never
+    decreasing) with more than 4 samples per pixel column of their axes. Lines whose x goes
+    back and forth (the disc centre's path) are left out: an envelope of sample runs would cut
+    chords across them."""
+    found = []
     for ax in fig.axes:
         width = max(1, int(ax.bbox.width))
         for line in ax.get_lines():
             x, y = (np.asarray(v, dtype=float) for v in line.get_data())
             if (len(x) > 4 * width and line.get_linestyle() not in ("None", "", " ")
                     and bool(np.all(np.diff(x) >= 0))):
-                px = line.get_transform().transform(np.column_stack([x, np.zeros_like(x)]))[:, 0]
-                line.set_data(*pixel_envelope(x, y, px))
+                found.append((line, x, y))
+    return found
+
+
+def _thin_lines(fig: Any) -> None:
+    """Replace every long trace of ``fig`` (:func:`_long_traces`) by its per-pixel-column
+    envelope (:func:`pixel_envelope`) at the axes' final place and limits: call it after the
+    layout, just before drawing."""
+    for line, x, y in _long_traces(fig):
+        px = line.get_transform().transform(np.column_stack([x, np.zeros_like(x)]))[:, 0]
+        line.set_data(*pixel_envelope(x, y, px))
 
 
 #: Resolution [dots per inch] of the figures.
@@ -181,7 +190,15 @@ def _new_figure(figsize: tuple[float, float], ncols: int = 1) -> tuple[Any, Any]
 
 def _save(fig: Any, path: Path) -> None:
     """Lay ``fig`` out (tight), thin its long traces to its pixels and write it as PNG."""
+    # The layout does not depend on the lines' data (they are clipped to their axes, and the
+    # axes limits are already set), but it places the legends, and a legend at loc="best"
+    # searches every vertex: during the layout the long traces hold their two end points only.
+    traces = _long_traces(fig)
+    for line, x, y in traces:
+        line.set_data(x[[0, -1]], y[[0, -1]])
     fig.tight_layout()
+    for line, x, y in traces:
+        line.set_data(x, y)
     _thin_lines(fig)  # the traces hold 50 000 samples; a figure is ~1000 pixels wide
     fig.savefig(path, dpi=DPI, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
 
