@@ -409,8 +409,9 @@ def main(args: argparse.Namespace) -> int:
     loads = LOAD_CASES if load == "all" else (load,)
     t_end = float(getattr(args, "t_end", 5.0))
     integrator = getattr(args, "integrator", None) or "generalized-alpha"
-    print(f"running load case{'s' if len(loads) > 1 else ''} {', '.join(map(repr, loads))}: "
-          f"{t_end} s simulated each with {integrator} ...", flush=True)
+    several = len(loads) > 1
+    print(f"running load case{'s' if several else ''} {', '.join(map(repr, loads))}: "
+          f"{t_end} s simulated{' each' if several else ''} with {integrator} ...", flush=True)
     _import_matplotlib()
     helper = _Helper.start(out)
     mine = [name for name in FIGURES if helper is None or name not in HELPER_FIGURES]
