@@ -281,12 +281,20 @@ HELPER_FIGURES = ("output_speed", "disc_center")
 
 
 def _helper_loop(conn: Any, out: Path) -> None:
-    """Body of the helper process: draw the figures of each job received on ``conn`` until
-    None comes; reply the files written, or the exception raised."""
+    """Body of the helper process: import matplotlib (while the caller does the same and the
+    first run goes), then draw the figures of each job received on ``conn`` until None comes;
+    reply the files written, or the exception raised."""
     try:
+        failed: Exception | None = None
+        try:
+            _import_matplotlib()
+        except Exception as exc:  # reported with the first job
+            failed = exc
         while (job := conn.recv()) is not None:
             load, theory, arrays = job
             try:
+                if failed is not None:
+                    raise failed
                 reply: Any = _write_figures(load, theory, Result(arrays, {}), out, HELPER_FIGURES)
             except Exception as exc:  # sent back and raised by the caller
                 reply = exc
@@ -300,9 +308,10 @@ def _helper_loop(conn: Any, out: Path) -> None:
 class _Helper:
     """A process drawing :data:`HELPER_FIGURES` while the caller draws the others.
 
-    Forked after matplotlib is imported and before any thread is started (so the child holds
-    no lock of another thread and needs no imports of its own). None of this where fork is
-    not the platform's way or other Python threads already run: then the caller draws all."""
+    Forked before any thread is started (so the child holds no lock of another thread), and
+    before matplotlib is imported, so that the runs start at once: both processes import it
+    while the first run goes. None of this where fork is not the platform's way or other
+    Python threads already run: then the caller draws all."""
 
     def __init__(self, proc: Any, conn: Any) -> None:
         self.proc, self.conn, self.pending = proc, conn, 0
@@ -412,7 +421,6 @@ def main(args: argparse.Namespace) -> int:
     several = len(loads) > 1
     print(f"running load case{'s' if several else ''} {', '.join(map(repr, loads))}: "
           f"{t_end} s simulated{' each' if several else ''} with {integrator} ...", flush=True)
-    _import_matplotlib()
     helper = _Helper.start(out)
     mine = [name for name in FIGURES if helper is None or name not in HELPER_FIGURES]
     summaries = []
@@ -420,6 +428,7 @@ def main(args: argparse.Namespace) -> int:
     try:
         # No progress bar: one from the worker thread would mix with the lines printed here.
         runs = [pool.submit(run_case, case, t_end, integrator, False) for case in loads]
+        _import_matplotlib()  # while the first run goes
         for case, run in zip(loads, runs):
             scene, result, wall = run.result()
             if helper is not None:
