@@ -88,6 +88,14 @@ pub struct GeneralizedAlpha {
     /// Whether the end-of-step power flows are evaluated (one more force evaluation per step)
     /// for the energy balance; otherwise the work integrals are not kept.
     pub track_work: bool,
+    /// With `track_work`: leave the end-of-step power flows and work increment of a step
+    /// taken whole to the caller (`pending`), who may have an evaluation at that state anyway
+    /// (a recorded sample); split steps still do their own.
+    pub defer_work: bool,
+    /// The step whose power flows and work increment were left to the caller.
+    pub pending: Option<f64>,
+    /// Whether the step being attempted defers its power flows.
+    defer_now: bool,
     /// `df/dq` and `df/dv` by finite differences, kept to re-assemble `J` for a new step.
     stiffness: Option<(DMatrix<f64>, DMatrix<f64>)>,
     lu: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
@@ -132,6 +140,9 @@ impl GeneralizedAlpha {
             newton_kappa: NEWTON_KAPPA,
             max_newton: 8,
             track_work,
+            defer_work: false,
+            pending: None,
+            defer_now: false,
             stiffness: None,
             lu: None,
             lu_h: 0.0,
@@ -169,12 +180,20 @@ impl GeneralizedAlpha {
         h: f64,
         depth: u32,
     ) -> Result<()> {
+        // Only a step taken whole leaves its power flows to the caller: the caller sees the
+        // whole step's ends, not the inner ends of a split one.
+        self.defer_now = self.track_work && self.defer_work && depth == 0;
+        self.pending = None;
         match self.attempt(sys, st, h) {
             Ok(Some(a)) => {
+                if self.defer_now {
+                    self.pending = Some(h);
+                }
                 self.accept(st, a);
                 Ok(())
             }
             Ok(None) | Err(_) if depth < 10 => {
+                self.defer_now = false;
                 self.splits += 1;
                 self.advance(sys, st, 0.5 * h, depth + 1)?;
                 self.advance(sys, st, 0.5 * h, depth + 1)
@@ -341,7 +360,7 @@ impl GeneralizedAlpha {
                     power: st.power,
                     work: st.work,
                 };
-                if self.track_work {
+                if self.track_work && !self.defer_now {
                     let mut a_end = vec![0.0; n];
                     sys.eval(next.t, &next.q, &next.v, &mut a_end, &mut next.power)?;
                     self.evaluations += 1;
@@ -407,6 +426,15 @@ impl Integrator for GeneralizedAlphaRun {
         self.stepper.step(sys, st, self.clock.h)?;
         self.clock.tick(st);
         Ok(())
+    }
+
+    fn defer_step_power(&mut self) -> bool {
+        self.stepper.defer_work = true;
+        true
+    }
+
+    fn pending_work(&self) -> Option<f64> {
+        self.stepper.pending
     }
 
     fn stats(&self) -> Stats {

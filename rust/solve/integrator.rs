@@ -47,6 +47,20 @@ pub trait Integrator: Send {
     fn advance(&mut self, sys: &dyn MechanicalSystem, st: &mut State, t_end: f64) -> Result<()>;
     /// Counts of the work done so far.
     fn stats(&self) -> Stats;
+    /// Ask the integrator to leave the power flows at the end of each whole step, and the
+    /// work increment `h (P0 + P1) / 2` that needs them, to the caller (see
+    /// [`Integrator::pending_work`]); `true` if it does so from now on. A caller that records a
+    /// sample at the step end gets the power flows from that sample's evaluation instead of a
+    /// second one at the same state. The default integrator keeps doing its own.
+    fn defer_step_power(&mut self) -> bool {
+        false
+    }
+    /// After [`Integrator::advance`] with deferral on: `Some(h)` if the step (of `h` s) left
+    /// `st.power` and `st.work` at their start values, for the caller to set
+    /// `st.power = P1` and `st.work += h (P0 + P1) / 2`; `None` if they are done.
+    fn pending_work(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// A registered integrator: its names, default step and constructor.

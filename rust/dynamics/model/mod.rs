@@ -72,6 +72,9 @@ pub struct Observation {
     pub output_shaft_torque: f64,
     /// Torque in the drive shaft [N m] (without one: the input torque).
     pub input_shaft_torque: f64,
+    /// Power flows `[input, output, dissipated]` [W], as `MechanicalSystem::eval` gives them
+    /// at this state (zero when the sink wants no forces).
+    pub power: [f64; 3],
 }
 
 /// A reducer model the driver can integrate and record.

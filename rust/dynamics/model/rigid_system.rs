@@ -275,6 +275,20 @@ impl ReducerModel for RigidSystem<'_> {
             } else {
                 input_torque
             },
+            // As `eval` (xv[LOAD] is the carrier's without an output shaft).
+            power: if sink.wants_forces() {
+                [
+                    match (m.prescribed, m.drive.torque(t)) {
+                        (Some(p), _) => -qa[p] * xv[p],
+                        (None, Some(tq)) => tq * xv[m.input],
+                        (None, None) => 0.0,
+                    },
+                    m.load.torque(t) * xv[LOAD],
+                    f.dissipation + sh.dissipation,
+                ]
+            } else {
+                [0.0; 3]
+            },
         })
     }
 }

@@ -1,6 +1,6 @@
 //! Recording of selected channels at sample times, into flat arrays (first axis = time).
 
-use crate::dynamics::model::{Layout, ReducerModel};
+use crate::dynamics::model::{Layout, Observation, ReducerModel};
 use crate::dynamics::run::sink::ContactSink;
 use crate::error::{Result, RvdynError};
 use crate::solve::Stats;
@@ -595,9 +595,29 @@ impl Recorder {
         v: &[f64],
         work: [f64; 3],
     ) -> Result<()> {
+        let obs = self.observe(model, t, q, v)?;
+        self.push_observed(t, &obs, work);
+        Ok(())
+    }
+
+    /// The first half of [`Recorder::sample`]: evaluate the state `(q, v)` at `t` into the
+    /// sample buffers; the observation's power flows can then serve the work integral before
+    /// [`Recorder::push_observed`] records the sample.
+    pub fn observe<M: ReducerModel>(
+        &mut self,
+        model: &M,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<Observation> {
+        model.observe(t, q, v, &mut self.sink)
+    }
+
+    /// The second half of [`Recorder::sample`]: append the sample at `t` of the last
+    /// [`Recorder::observe`], with integrated `work`.
+    pub fn push_observed(&mut self, t: f64, obs: &Observation, work: [f64; 3]) {
         let channels = self.channels.clone();
         let has = |c| channels.contains(&c);
-        let obs = model.observe(t, q, v, &mut self.sink)?;
         self.push("t", &[t]);
         if has(Channel::Motion) {
             self.push("sun_angle", &[obs.sun_angle]);
@@ -674,7 +694,6 @@ impl Recorder {
             self.push("eccentric_bearing_force", &eb);
         }
         self.rec.samples += 1;
-        Ok(())
     }
 
     pub fn finish(self) -> Recording {

@@ -631,6 +631,18 @@ impl ReducerModel for CompliantModel {
             kinetic_energy: self.kinetic_energy(&xv),
             potential_energy: flows.potential,
             friction_power: flows.friction,
+            // As `eval`.
+            power: [
+                match m.drive.torque(t) {
+                    Some(tq) => {
+                        let share = tq / self.input.len() as f64;
+                        self.input.iter().map(|&i| share * xv[i]).sum()
+                    }
+                    None => -self.prescribed.iter().map(|&p| qf[p] * xv[p]).sum::<f64>(),
+                },
+                m.load.torque(t) * xv[self.load_index.unwrap_or(CARRIER)],
+                flows.dissipation,
+            ],
         })
     }
 }
