@@ -10,12 +10,14 @@
 //!
 //! `run T METHOD JOINTS [record|-] [ATOL RTOL]`: `dynamics::simulate` of the rated default
 //! scene for T s with no channels recorded (JOINTS `rigid`, `compliant`, or `physical` for the
-//! physical preset), or with `record` the default channels at every step; `rhs N`: N force evaluations of the
+//! physical preset), or with `record` the default channels at every step, or with `goal=DT`
+//! benches/speed_goal.py's run at the step DT (motion and pins every 1 ms); `rhs N`: N force evaluations of the
 //! rigid rated scene at one loaded state (after 0.05 s from rest); `phys N`: N force evaluations of
 //! the physical rated preset (compliant roller bearings) at one loaded state (after 0.1 s from
 //! rest).
 use rvdyn::dynamics::compliant::CompliantModel;
 use rvdyn::dynamics::model::ReducerModel;
+use rvdyn::dynamics::record::Channel;
 use rvdyn::dynamics::system::RigidSystem;
 use rvdyn::dynamics::{RigidModel, RunControl, Scene, SimOptions, simulate};
 use rvdyn::solve::generalized_alpha::GeneralizedAlpha;
@@ -77,6 +79,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if arg(5, "") == "record" {
         // The default channels at every step (record interval = the step).
         opt.record_interval = Some(SimOptions::default_dt(method));
+    } else if let Some(dt) = arg(5, "").strip_prefix("goal=") {
+        // benches/speed_goal.py's run: step dt, motion and pins every 1 ms.
+        opt.dt = Some(dt.parse()?);
+        opt.record_interval = Some(1e-3);
+        opt.channels = vec![Channel::Motion, Channel::Pins];
     } else {
         opt.channels = vec![];
     }

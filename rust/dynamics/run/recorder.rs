@@ -580,12 +580,6 @@ impl Recorder {
         Ok(())
     }
 
-    fn push(&mut self, name: &'static str, values: &[f64]) {
-        if let Some(s) = self.rec.series.get_mut(name) {
-            s.data.extend_from_slice(values);
-        }
-    }
-
     /// Record the free state `(q, v)` at `t` with integrated `work`.
     pub fn sample<M: ReducerModel>(
         &mut self,
@@ -616,84 +610,83 @@ impl Recorder {
     /// The second half of [`Recorder::sample`]: append the sample at `t` of the last
     /// [`Recorder::observe`], with integrated `work`.
     pub fn push_observed(&mut self, t: f64, obs: &Observation, work: [f64; 3]) {
-        let channels = self.channels.clone();
+        // Split borrows: the sink's buffers go into the series without copies.
+        let Self {
+            channels,
+            rec,
+            sink,
+            nd,
+            initial_energy,
+        } = self;
+        let nd = *nd;
         let has = |c| channels.contains(&c);
-        self.push("t", &[t]);
-        if has(Channel::Motion) {
-            self.push("sun_angle", &[obs.sun_angle]);
-            self.push("sun_speed", &[obs.sun_speed]);
-            self.push("carrier_angle", &[obs.carrier_angle]);
-            self.push("carrier_speed", &[obs.carrier_speed]);
-            self.push("crank_angle", &obs.crank_angle);
-            self.push("crank_speed", &obs.crank_speed);
-            for k in 0..self.nd {
-                self.push("disc_center", &obs.disc_center[k]);
+        let mut push = |name: &'static str, values: &[f64]| {
+            if let Some(s) = rec.series.get_mut(name) {
+                s.data.extend_from_slice(values);
             }
-            self.push("disc_angle", &obs.disc_angle);
-            self.push("load_angle", &[obs.load_angle]);
-            self.push("load_speed", &[obs.load_speed]);
-            self.push("motor_angle", &[obs.motor_angle]);
-            self.push("motor_speed", &[obs.motor_speed]);
+        };
+        push("t", &[t]);
+        if has(Channel::Motion) {
+            push("sun_angle", &[obs.sun_angle]);
+            push("sun_speed", &[obs.sun_speed]);
+            push("carrier_angle", &[obs.carrier_angle]);
+            push("carrier_speed", &[obs.carrier_speed]);
+            push("crank_angle", &obs.crank_angle);
+            push("crank_speed", &obs.crank_speed);
+            for k in 0..nd {
+                push("disc_center", &obs.disc_center[k]);
+            }
+            push("disc_angle", &obs.disc_angle);
+            push("load_angle", &[obs.load_angle]);
+            push("load_speed", &[obs.load_speed]);
+            push("motor_angle", &[obs.motor_angle]);
+            push("motor_speed", &[obs.motor_speed]);
         }
         if has(Channel::Pins) {
-            let zp = self.sink.zp;
-            let loaded: Vec<f64> = (0..self.nd)
+            let zp = sink.zp;
+            let loaded: Vec<f64> = (0..nd)
                 .map(|k| {
-                    self.sink.force[k * zp..(k + 1) * zp]
+                    sink.force[k * zp..(k + 1) * zp]
                         .iter()
                         .filter(|f| **f > 0.0)
                         .count() as f64
                 })
                 .collect();
-            let (f, p, m) = (
-                self.sink.force.clone(),
-                self.sink.pen.clone(),
-                self.sink.moment.clone(),
-            );
-            self.push("pin_force", &f);
-            self.push("pin_penetration", &p);
-            self.push("pin_moment", &m);
-            self.push("loaded_pins", &loaded);
+            push("pin_force", &sink.force);
+            push("pin_penetration", &sink.pen);
+            push("pin_moment", &sink.moment);
+            push("loaded_pins", &loaded);
         }
         if has(Channel::ContactPoints) {
-            let (pt, nm) = (self.sink.point.clone(), self.sink.normal.clone());
-            self.push("pin_point", &pt);
-            self.push("pin_normal", &nm);
+            push("pin_point", &sink.point);
+            push("pin_normal", &sink.normal);
         }
         if has(Channel::Mesh) {
-            let (mf, md) = (
-                self.sink.mesh_force.clone(),
-                self.sink.mesh_deflection.clone(),
-            );
-            self.push("mesh_force", &mf);
-            self.push("mesh_deflection", &md);
-            self.push("input_torque", &[obs.input_torque]);
-            self.push("output_shaft_torque", &[obs.output_shaft_torque]);
-            self.push("input_shaft_torque", &[obs.input_shaft_torque]);
+            push("mesh_force", &sink.mesh_force);
+            push("mesh_deflection", &sink.mesh_deflection);
+            push("input_torque", &[obs.input_torque]);
+            push("output_shaft_torque", &[obs.output_shaft_torque]);
+            push("input_shaft_torque", &[obs.input_shaft_torque]);
         }
         if has(Channel::Energy) {
             let e = obs.kinetic_energy + obs.potential_energy;
-            let e0 = *self.initial_energy.get_or_insert(e);
+            let e0 = *initial_energy.get_or_insert(e);
             let residual = e - e0 - work[0] + work[1] + work[2];
-            self.push("kinetic_energy", &[obs.kinetic_energy]);
-            self.push("potential_energy", &[obs.potential_energy]);
-            self.push("input_work", &[work[0]]);
-            self.push("output_work", &[work[1]]);
-            self.push("dissipated_energy", &[work[2]]);
-            self.push("pin_friction_power", &[obs.friction_power[0]]);
-            self.push("mesh_friction_power", &[obs.friction_power[1]]);
-            self.push("bearing_friction_power", &[obs.friction_power[2]]);
-            self.push("energy_residual", &[residual]);
+            push("kinetic_energy", &[obs.kinetic_energy]);
+            push("potential_energy", &[obs.potential_energy]);
+            push("input_work", &[work[0]]);
+            push("output_work", &[work[1]]);
+            push("dissipated_energy", &[work[2]]);
+            push("pin_friction_power", &[obs.friction_power[0]]);
+            push("mesh_friction_power", &[obs.friction_power[1]]);
+            push("bearing_friction_power", &[obs.friction_power[2]]);
+            push("energy_residual", &[residual]);
         }
         if has(Channel::Bearings) {
-            let (cb, eb) = (
-                self.sink.crank_bearing.clone(),
-                self.sink.eccentric_bearing.clone(),
-            );
-            self.push("crank_bearing_force", &cb);
-            self.push("eccentric_bearing_force", &eb);
+            push("crank_bearing_force", &sink.crank_bearing);
+            push("eccentric_bearing_force", &sink.eccentric_bearing);
         }
-        self.rec.samples += 1;
+        rec.samples += 1;
     }
 
     pub fn finish(self) -> Recording {
