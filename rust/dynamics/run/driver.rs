@@ -375,8 +375,8 @@ pub fn run_with<M: ReducerModel>(
                     || (next_sample + 1) as f64 * interval > st.t + 1e-12);
             let complete = |st: &mut State, power: [f64; 3]| {
                 st.power = power;
-                for j in 0..3 {
-                    st.work[j] += 0.5 * h * (prev.power[j] + power[j]);
+                for (w, (p0, p1)) in st.work.iter_mut().zip(prev.power.iter().zip(power)) {
+                    *w += 0.5 * h * (p0 + p1);
                 }
             };
             if only_at_end {
