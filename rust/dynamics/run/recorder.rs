@@ -493,6 +493,9 @@ impl ContactSink for SampleSink {
 pub(crate) struct Recorder {
     channels: Vec<Channel>,
     rec: Recording,
+    /// The recorded series in [`CHANNELS`] order while recording (into `rec` at the end):
+    /// a sample pushes them in this order, so each is found at or just after the last one.
+    buffers: Vec<(&'static str, Series)>,
     sink: SampleSink,
     nd: usize,
     initial_energy: Option<f64>,
@@ -504,14 +507,14 @@ impl Recorder {
         let zp = layout.pins;
         let nm = layout.meshes;
         let has = |c| channels.contains(&c);
-        let mut series: BTreeMap<&'static str, Series> = BTreeMap::new();
+        let mut buffers: Vec<(&'static str, Series)> = Vec::new();
         for c in CHANNELS {
             if c.group.is_some_and(|g| !has(g)) {
                 continue;
             }
             let shape: Vec<usize> = c.shape.iter().map(|d| d.size(&layout)).collect();
             let per: usize = shape.iter().product();
-            series.insert(
+            buffers.push((
                 c.name,
                 Series {
                     // Reserve at most 2^20 samples up front: a huge sample count from a long run
@@ -519,7 +522,7 @@ impl Recorder {
                     data: Vec::with_capacity(capacity.min(1 << 20) * per),
                     sample_shape: shape,
                 },
-            );
+            ));
         }
         let sink = SampleSink {
             zp,
@@ -540,12 +543,13 @@ impl Recorder {
         Self {
             channels: channels.to_vec(),
             rec: Recording {
-                series,
+                series: BTreeMap::new(),
                 samples: 0,
                 stats: Stats::default(),
                 warnings: Vec::new(),
                 final_state: None,
             },
+            buffers,
             sink,
             nd,
             initial_energy: None,
@@ -554,17 +558,16 @@ impl Recorder {
 
     /// Values recorded per sample over all series.
     pub fn values_per_sample(&self) -> usize {
-        self.rec
-            .series
-            .values()
-            .map(|s| s.sample_shape.iter().product::<usize>())
+        self.buffers
+            .iter()
+            .map(|(_, s)| s.sample_shape.iter().product::<usize>())
             .sum()
     }
 
     /// Reserve room for `samples` samples in every series without the aborting allocation
     /// path: `RvdynError::Memory` if the memory cannot be had.
     pub fn reserve(&mut self, samples: usize) -> Result<()> {
-        for (name, s) in self.rec.series.iter_mut() {
+        for (name, s) in self.buffers.iter_mut() {
             let per: usize = s.sample_shape.iter().product();
             let n = samples.saturating_mul(per);
             let extra = n.saturating_sub(s.data.len());
@@ -614,15 +617,23 @@ impl Recorder {
         let Self {
             channels,
             rec,
+            buffers,
             sink,
             nd,
             initial_energy,
         } = self;
         let nd = *nd;
         let has = |c| channels.contains(&c);
+        let mut cursor = 0;
         let mut push = |name: &'static str, values: &[f64]| {
-            if let Some(s) = rec.series.get_mut(name) {
-                s.data.extend_from_slice(values);
+            let n = buffers.len();
+            for k in 0..n {
+                let i = (cursor + k) % n;
+                if buffers[i].0 == name {
+                    buffers[i].1.data.extend_from_slice(values);
+                    cursor = i;
+                    return;
+                }
             }
         };
         push("t", &[t]);
@@ -690,6 +701,8 @@ impl Recorder {
     }
 
     pub fn finish(self) -> Recording {
-        self.rec
+        let mut rec = self.rec;
+        rec.series = self.buffers.into_iter().collect();
+        rec
     }
 }
