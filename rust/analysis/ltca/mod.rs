@@ -168,6 +168,8 @@ pub struct Ltca {
     work: Work,
     /// Newton's scratch space, with the contact state at the last solution.
     scratch: Scratch,
+    /// The unknowns whose contact state `scratch` holds for a report (empty: none).
+    captured_q: Vec<f64>,
     /// Keep the contact state of the next solution (for its report).
     capture: bool,
     /// Last solution `(psi, q)`: the warm start of the next.
@@ -202,6 +204,7 @@ impl Ltca {
             options,
             work: Work::new(),
             scratch: Scratch::default(),
+            captured_q: Vec::new(),
             capture: false,
             last: None,
             before: None,
@@ -332,6 +335,7 @@ impl Ltca {
         let solved = self.solve_unknowns(torque, psi);
         self.capture = false;
         let (q, rep) = solved?;
+        self.captured_q.clone_from(&q);
         self.point(torque, psi, &q, rep)
     }
 
@@ -374,9 +378,31 @@ impl Ltca {
         // (`work.k_last`) and its contact state, with fresh gaps of the pins the separation
         // bound skipped there (no force either way).
         let x = st.full(psi, q);
-        let mut cs = std::mem::take(&mut self.scratch.state);
-        st.refresh_skipped_jets(&x, &mut cs)?;
-        let mut k = self.work.k_last.clone();
+        let captured = std::mem::take(&mut self.captured_q);
+        let (cs, mut k) = if captured.as_slice() == q {
+            let mut cs = std::mem::take(&mut self.scratch.state);
+            st.refresh_skipped_jets(&x, &mut cs)?;
+            (cs, self.work.k_last.clone())
+        } else {
+            // Not the state Newton just captured (another caller's unknowns): evaluate afresh,
+            // every pin queried.
+            let mut r = vec![0.0; n];
+            let mut k = statics::Dense::zeros(n);
+            let mut cs = statics::ContactState::default();
+            st.exact = true;
+            let evaluated = st.eval(
+                psi,
+                q,
+                torque,
+                &mut r,
+                &mut k,
+                &mut self.work,
+                Some(&mut cs),
+            );
+            st.exact = false;
+            evaluated?;
+            (cs, k)
+        };
         let mut e0 = vec![0.0; n];
         e0[0] = 1.0;
         let stiff = if solve_dense(&mut k, &mut e0) && e0[0] > 0.0 {
