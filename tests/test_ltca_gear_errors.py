@@ -68,7 +68,7 @@ def test_sun_runout_te_is_the_most_advanced_mesh_over_i_rbs() -> None:
     # rad, with the light-load approach x_1 of the one loaded mesh instead of the x_3 of three
     # sharing the load without errors (IMPACT law inverted: 3.1e-8 and 1.5e-8 m). Residual: the
     # crank-angle shift zc dTE of the pin contact (second order: the unmodified profile's
-    # light-load TE is flat over such a shift). Asserted 1e-3 of the amplitude.
+    # light-load TE is flat over such a shift). Measured 3e-5; asserted 1e-3 of the amplitude.
     e, phase = 1e-5, 0.4
     psi = np.linspace(0.0, 0.5, 26)
     scene = PAPER.replace(**{"gear_errors.sun.runout": e, "gear_errors.sun.runout_phase": phase})
@@ -88,8 +88,10 @@ def test_planet_pitch_errors_in_phase_turn_the_carrier_by_e_over_i_rbs(torque: f
     # same approach E: the meshes keep their loads, and the carrier turns by E / (i r_bs) at any
     # load (rigid joints). The pins see the crank turned by zc dTE (up to 7.5e-5 rad): the
     # error-free TE's slope times that shift is the second-order residual (7e-9 rad at rated
-    # load, nothing at light load). Asserted: 1e-3 of the amplitude 3.3e-6 rad plus twice that
-    # residual bound, computed from the error-free TE.
+    # load, nothing at light load). Asserted: 2e-3 of the amplitude 3.3e-6 rad plus twice that
+    # residual bound, computed from the error-free TE. At light load the pins' own approach
+    # (IMPACT law, ~2e-7 m at the ~1 N of 0.1 N m) shifts with the crank by more than the
+    # sampled slope shows: measured 8e-4 of the amplitude there; asserted 2e-3.
     a, phase = 5e-6, 0.9
     psi = np.linspace(0.0, 0.5, 26)
     scene = PAPER.replace(**{"gear_errors.planets": _in_phase_planets(a, phase)})
@@ -99,7 +101,7 @@ def test_planet_pitch_errors_in_phase_turn_the_carrier_by_e_over_i_rbs(torque: f
     amp = math.cos(PA) * a / (RATIO * R_BS)
     err = np.abs((te - te0) - expected).max()
     slope = np.abs(np.gradient(te0, psi)).max()
-    assert err < 1e-3 * amp + 2 * ZC * amp * slope, (err, amp, slope)
+    assert err < 2e-3 * amp + 2 * ZC * amp * slope, (err, amp, slope)
 
 
 @pytest.fixture(scope="module")
