@@ -486,8 +486,11 @@ class LtcaSolver:
         """Worst load case per disc over every point solved so far: (CSV, JSON)."""
     def transmission_error(self, torque: float, light: float, points: int, start: float) -> dict[str, Any]:
         """TE over one mesh period at +-torque and +-light [N m]."""
-    def twist_loop(self, rated: float, crank_angle: float, points: int) -> dict[str, Any]:
-        """Torque-twist loop with rigidity, lost motion and backlash."""
+    def twist_loop(self, rated: float, crank_angle: float, points: int, friction: bool = True) -> dict[str, Any]:
+        """Torque-twist loop with rigidity, lost motion and backlash (with the scene's friction
+        unless ``friction`` is false)."""
+    def friction_sweep(self, torque: float, crank_angles: list[float]) -> dict[str, Any]:
+        """Running sweep with the scene's friction: TE [rad] and input torque [N m]."""
 
 # ---- vibration analyses (rust/python/modal.rs) ------------------------------------------------
 

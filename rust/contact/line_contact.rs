@@ -59,6 +59,8 @@ pub struct LineContactLaw {
     alpha: f64,
     /// Start of the linear extension: force [N], approach [m], compliance d delta/dF [m/N].
     f_lim: f64,
+    /// `ln f_lim` (kept: the inversion's bound).
+    x_lim: f64,
     delta_lim: f64,
     compliance_lim: f64,
 }
@@ -153,6 +155,7 @@ impl LineContactLaw {
             k1,
             alpha,
             f_lim,
+            x_lim,
             delta_lim,
             compliance_lim,
         };
@@ -199,6 +202,31 @@ impl LineContactLaw {
         }
         let h2 = disc_reference_depth(profile_curvature, disc_depth).depth;
         Self::new(
+            face_width,
+            1.0 / pin_radius,
+            profile_curvature,
+            pin_radius,
+            h2,
+            pin,
+            disc,
+        )
+    }
+
+    /// [`LineContactLaw::pin_disc`] for a positive finite pin radius, valid materials (checked
+    /// once by the caller) and a finite profile curvature, with the disc's reference depth
+    /// `disc_reference_depth(profile_curvature, body depth).depth` given as `h2` [m]: the same
+    /// law without re-checking its input at every contact evaluation. Errors (`Geometry`) for
+    /// a non-positive curvature sum, as [`LineContactLaw::new`].
+    #[inline]
+    pub(crate) fn pin_disc_checked(
+        pin_radius: f64,
+        profile_curvature: f64,
+        h2: f64,
+        face_width: f64,
+        pin: &Material,
+        disc: &Material,
+    ) -> Result<Self> {
+        Self::from_checked(
             face_width,
             1.0 / pin_radius,
             profile_curvature,
@@ -369,7 +397,7 @@ impl LineContactLaw {
             return (f, 1.0 / self.compliance_lim, f.ln());
         }
         let ln_d = delta.ln();
-        let x_lim = self.f_lim.ln();
+        let x_lim = self.x_lim;
         let mut x = if ln_force_guess.is_finite() && ln_force_guess <= x_lim {
             ln_force_guess
         } else {
@@ -491,6 +519,16 @@ pub fn pin_disc_profile_curvature(
     generating_pin_radius: f64,
 ) -> Result<f64> {
     require_non_negative("generating pin radius", generating_pin_radius, "m")?;
+    profile_curvature_checked(centre_curvature, generating_pin_radius)
+}
+
+/// [`pin_disc_profile_curvature`] for a generating pin radius checked once by the caller
+/// (finite, >= 0): the same value and the same `Geometry` error.
+#[inline]
+pub(crate) fn profile_curvature_checked(
+    centre_curvature: f64,
+    generating_pin_radius: f64,
+) -> Result<f64> {
     let denom = 1.0 - generating_pin_radius * centre_curvature;
     if !(centre_curvature.is_finite() && denom > 0.0) {
         return Err(RvdynError::Geometry(format!(

@@ -115,17 +115,22 @@ impl LtcaSolver {
         Ok(d)
     }
 
-    /// The torque-twist loop at `crank_angle` [rad] over +-`rated` [N m] with `points` points.
+    /// The torque-twist loop at `crank_angle` [rad] over +-`rated` [N m] with `points` points;
+    /// `friction`: apply the scene's friction (if it has any).
+    #[pyo3(signature = (rated, crank_angle, points, friction = true))]
     fn twist_loop<'py>(
         &mut self,
         py: Python<'py>,
         rated: f64,
         crank_angle: f64,
         points: usize,
+        friction: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
-        let lp = py.detach(|| ltca.twist_loop(rated, crank_angle, points))?;
+        let applied = friction && ltca.friction_laws().any();
+        let lp = py.detach(|| ltca.twist_loop_with(rated, crank_angle, points, friction))?;
         let d = PyDict::new(py);
+        d.set_item("friction", applied)?;
         let n = lp.torque.len();
         d.set_item("torque", f64_array(py, lp.torque, vec![n])?)?;
         d.set_item("twist", f64_array(py, lp.twist, vec![n])?)?;
@@ -136,6 +141,31 @@ impl LtcaSolver {
         d.set_item("rigidity", lp.rigidity)?;
         d.set_item("lost_motion", lp.lost_motion)?;
         d.set_item("backlash", lp.backlash)?;
+        Ok(d)
+    }
+
+    /// A running sweep with the scene's friction at `crank_angles` [rad] under the output
+    /// torque `torque` [N m] (the input driving against it): TE [rad] and the held input's
+    /// torque [N m] per crank angle.
+    fn friction_sweep<'py>(
+        &mut self,
+        py: Python<'py>,
+        torque: f64,
+        crank_angles: Vec<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
+        let laws = ltca.friction_laws().clone();
+        let r = py.detach(|| ltca.friction_sweep(&laws, torque, &crank_angles))?;
+        let n = r.len();
+        let d = PyDict::new(py);
+        d.set_item(
+            "transmission_error",
+            f64_array(py, r.iter().map(|p| p.0).collect(), vec![n])?,
+        )?;
+        d.set_item(
+            "input_torque",
+            f64_array(py, r.iter().map(|p| p.1).collect(), vec![n])?,
+        )?;
         Ok(d)
     }
 }

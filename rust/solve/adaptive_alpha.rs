@@ -41,6 +41,10 @@
 //! Norsett & Wanner, Solving ODEs I, 2nd ed., section II.4, on error per step and per unit
 //! step). Counted as `nonsmooth` in the statistics.
 //!
+//! **First touch.** A step that closes a contact from open to deeper than its law's damping
+//! ramp (`MechanicalSystem::deepest_first_touch`, the IMPACT law's damping depth) is rejected and
+//! retried shorter, whatever its error estimate; counted as `too_deep`.
+//!
 //! **Limits.** The step stays in `[h_min, h_max]`; below `h_min`, or beyond `max_steps`
 //! accepted steps, the run stops with a `SimulationError` naming the time and the cause.
 
@@ -83,6 +87,10 @@ pub struct AdaptiveAlpha {
     /// Steps accepted on their error per step after [`MAX_REJECTIONS`] error-test rejections
     /// in a row (a force not smooth in time within them).
     pub nonsmooth: u64,
+    /// Steps rejected because a contact closed deeper than its law allows in one step.
+    pub too_deep: u64,
+    /// Whether the contacts open at the run's start have been marked.
+    marked: bool,
     /// Error-test rejections since the run last passed the end of a rejected step.
     streak: u32,
     /// End time of the last rejected step [s] (-inf without one).
@@ -130,6 +138,8 @@ impl AdaptiveAlpha {
             rejected: 0,
             retried: 0,
             nonsmooth: 0,
+            too_deep: 0,
+            marked: false,
             streak: 0,
             streak_end: f64::NEG_INFINITY,
         })
@@ -181,6 +191,11 @@ impl Integrator for AdaptiveAlpha {
                 self.max_steps, t_end, st.t
             )));
         }
+        if !self.marked {
+            // The last evaluation is the start state's.
+            sys.mark_open_contacts();
+            self.marked = true;
+        }
         loop {
             let remaining = t_end - st.t;
             let mut h = self.h.min(self.h_max);
@@ -197,6 +212,21 @@ impl Integrator for AdaptiveAlpha {
             let (factor, why) = match outcome {
                 Ok(Some(a)) if a.theta <= 0.5 => {
                     let err = self.error_norm(sys, st, &a);
+                    // A contact that closed within the step deeper than its law's ramp (the
+                    // IMPACT damping depth) jumped the ramp: retry shorter, whatever the error
+                    // estimate says (the approach grows about linearly with the step).
+                    if let Some((depth, what)) = sys.deepest_first_touch().filter(|d| d.0 > 1.0) {
+                        self.too_deep += 1;
+                        self.h = h * (0.9 / depth).clamp(0.2, 0.9);
+                        if self.h < self.h_min {
+                            return Err(self.too_small(
+                                st,
+                                self.h,
+                                &format!("a contact closing too deep: {what}"),
+                            ));
+                        }
+                        continue;
+                    }
                     if err <= 1.0 {
                         // Past the trouble once the run passes the end of the last rejected
                         // step.
@@ -209,6 +239,7 @@ impl Integrator for AdaptiveAlpha {
                             0.9 * err.max(1e-10).powf(-0.7 / 2.0) * self.err_prev.powf(0.4 / 2.0);
                         self.err_prev = err.max(1e-4);
                         self.stepper.accept(st, a);
+                        sys.mark_open_contacts();
                         self.h = (h * grow.clamp(0.2, 2.0)).clamp(self.h_min, self.h_max);
                         return Ok(());
                     }
@@ -228,6 +259,7 @@ impl Integrator for AdaptiveAlpha {
                         self.nonsmooth += 1;
                         self.err_prev = 1.0;
                         self.stepper.accept(st, a);
+                        sys.mark_open_contacts();
                         self.h = h.clamp(self.h_min, self.h_max);
                         return Ok(());
                     }
@@ -273,6 +305,7 @@ impl Integrator for AdaptiveAlpha {
                 ("rejected", self.rejected),
                 ("retried", self.retried),
                 ("nonsmooth", self.nonsmooth),
+                ("too_deep", self.too_deep),
                 ("evaluations", g.evaluations),
                 ("jacobians", g.jacobians),
                 ("newton_iterations", g.newton_iterations),
@@ -510,5 +543,85 @@ mod tests {
         let exact = 0.5 * (1.0 - sys.t0) * (1.0 - sys.t0);
         assert!((st.q[0] - exact).abs() < 1e-4, "{} vs {exact}", st.q[0]);
         assert!(ga.nonsmooth >= 1, "{ga:?}");
+    }
+
+    /// A mass falling at 1 m/s onto a stop with an IMPACT-like law (`k x^1.5` with a damping
+    /// ramp over `RAMP`), gravity-free, starting 1 mm away: the first touch.
+    struct Drop {
+        /// Whether it reports first touches (the models' hook); false = the default trait.
+        report: bool,
+        last: std::cell::Cell<f64>,
+        marked: std::cell::Cell<f64>,
+    }
+
+    const RAMP: f64 = 1e-5;
+
+    impl MechanicalSystem for Drop {
+        fn dof(&self) -> usize {
+            1
+        }
+        fn eval(
+            &self,
+            _: f64,
+            q: &[f64],
+            v: &[f64],
+            a: &mut [f64],
+            _: &mut [f64; 3],
+        ) -> Result<()> {
+            let pen = q[0] - 1e-3;
+            self.last.set(pen);
+            a[0] = if pen > 0.0 {
+                let c = 2e2 * (pen / RAMP).min(1.0);
+                -1e9 * pen * pen.sqrt() - c * v[0]
+            } else {
+                0.0
+            };
+            Ok(())
+        }
+        fn length_scale(&self) -> &[f64] {
+            &[1.0]
+        }
+        fn mark_open_contacts(&self) {
+            self.marked.set(self.last.get());
+        }
+        fn deepest_first_touch(&self) -> Option<(f64, String)> {
+            let (m, l) = (self.marked.get(), self.last.get());
+            (self.report && m <= 0.0 && l > 0.0).then(|| (l / RAMP, "the stop".to_string()))
+        }
+    }
+
+    /// At a loose tolerance the step that first touches may close deeper than the law's
+    /// damping ramp (the ramp is then jumped); the first-touch check rejects such a step and
+    /// retries shorter: with it, no accepted step closes deeper than the ramp (within 1 %, the
+    /// depth at the last Newton evaluation against the accepted state), without it one does.
+    #[test]
+    fn a_contact_never_closes_deeper_than_its_ramp_in_one_step() {
+        let deepest_new_closure = |report: bool| {
+            let sys = Drop {
+                report,
+                last: std::cell::Cell::new(-1e-3),
+                marked: std::cell::Cell::new(-1e-3),
+            };
+            let mut ga = AdaptiveAlpha::new(&settings(1e-4)).unwrap();
+            let mut st = State::new(&sys, 0.0, vec![0.0], vec![1.0]).unwrap();
+            let mut worst: f64 = 0.0;
+            while st.t < 3e-3 {
+                let before = st.q[0] - 1e-3;
+                ga.advance(&sys, &mut st, 3e-3).unwrap();
+                let after = st.q[0] - 1e-3;
+                if before <= 0.0 && after > 0.0 {
+                    worst = worst.max(after);
+                }
+            }
+            (worst, ga.too_deep)
+        };
+        let (with, rejected) = deepest_new_closure(true);
+        let (without, _) = deepest_new_closure(false);
+        assert!(
+            without > RAMP,
+            "the loose run must jump the ramp: {without:e}"
+        );
+        assert!(with <= 1.01 * RAMP, "{with:e} m closed in one step");
+        assert!(rejected >= 1);
     }
 }

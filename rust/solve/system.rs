@@ -13,6 +13,16 @@ pub trait MechanicalSystem {
     /// Length per unit of each coordinate [m] (a lever arm for an angle): error control and
     /// Newton convergence act on displacements, not on angles that grow to tens of radians.
     fn length_scale(&self) -> &[f64];
+    /// Remember which contacts are open at the state of the last [`eval`](Self::eval) (an
+    /// adaptive integrator calls this after accepting a step). Default: no contacts.
+    fn mark_open_contacts(&self) {}
+    /// The deepest first touch since [`mark_open_contacts`](Self::mark_open_contacts): the
+    /// largest penetration, at the last evaluation, of a contact open at the mark, as a
+    /// multiple of the depth its law can take in one step (a ramp that the step must not
+    /// jump), with the contact's name. `None` when none closed (or no law has such a depth).
+    fn deepest_first_touch(&self) -> Option<(f64, String)> {
+        None
+    }
 }
 
 /// The integrated state: coordinates, velocities, accelerations and energy flows.

@@ -17,6 +17,7 @@ from .ltca import (
     TransmissionError,
     TwistLoop,
     ltca,
+    running_friction,
     torque_twist,
     transmission_error,
 )
@@ -28,6 +29,7 @@ __all__ = [
     "TransmissionError",
     "TwistLoop",
     "ltca",
+    "running_friction",
     "torque_twist",
     "transmission_error",
 ]

@@ -17,7 +17,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["ARCMIN", "ARCSEC", "LtcaResult", "TransmissionError", "TwistLoop", "ltca",
+__all__ = ["ARCMIN", "ARCSEC", "LtcaResult", "TransmissionError", "TwistLoop", "ltca", "running_friction",
            "torque_twist", "transmission_error"]
 
 #: One arc minute and one arc second [rad].
@@ -224,6 +224,28 @@ class TwistLoop:
     rigidity: float
     lost_motion: float
     backlash: float
+    friction: bool = False
+
+    def branches(self) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
+        """The loop's upper (unloading, ``+rated -> -rated``) and lower (loading, ``-rated ->
+        +rated``: the last quarter, then the first) branches as ``(torque, twist)`` pairs with
+        increasing torque. Without friction both are the same curve."""
+        n = self.torque.size
+        i_max = int(np.argmax(self.torque))
+        i_min = int(np.argmin(self.torque))
+        up_t, up_w = self.torque[i_max:i_min + 1][::-1], self.twist[i_max:i_min + 1][::-1]
+        lo_t = np.concatenate([self.torque[i_min:n], self.torque[1:i_max + 1]])
+        lo_w = np.concatenate([self.twist[i_min:n], self.twist[1:i_max + 1]])
+        return (up_t, up_w), (lo_t, lo_w)
+
+    def width(self, torque: float) -> float:
+        """Twist width of the loop [rad] at ``torque`` [N m] (upper minus lower branch,
+        linear interpolation between the loop's points); the friction's hysteresis."""
+        (ut, uw), (lt, lw) = self.branches()
+        t = float(torque)
+        if not (np.isfinite(t) and abs(t) <= self.rated_torque):
+            raise ParameterError(f"torque must be within +-rated ({self.rated_torque} N m), got {torque}")
+        return float(np.interp(t, ut, uw) - np.interp(t, lt, lw))
 
     def summary(self) -> dict[str, float]:
         """Rigidity [N m/arcmin], lost motion and backlash [arcmin]."""
@@ -302,14 +324,42 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int = 
 
 
 def torque_twist(scene: Scene, rated_torque: float | None = None, crank_angle: float = 0.0,
-                 points: int = 201) -> TwistLoop:
+                 points: int = 201, *, friction: bool = True) -> TwistLoop:
     """The torque-twist loop 0 -> +rated -> -rated -> 0 at ``crank_angle`` [rad] with the input
-    held, with rigidity, lost motion and backlash (catalogue definitions)."""
+    held, with rigidity, lost motion and backlash (catalogue definitions). With the scene's
+    friction (``scene.friction``; ``friction=False`` ignores it) the loop opens: quasi-static
+    Coulomb sliding at pins, teeth and joint bearings, sticking at each reversal
+    (docs/model.md, "Friction in the LTCA")."""
     sc = _scene(scene)
     t = abs(_rated(sc, rated_torque))
     d = _core.LtcaSolver(sc._compiled, 1e-12).twist_loop(t, _float("crank_angle", crank_angle, "rad"),
-                                                         int(points))
+                                                         int(points), bool(friction))
     return TwistLoop(crank_angle=float(crank_angle), rated_torque=t, torque=d["torque"],
                      twist=d["twist"], tangent_stiffness=d["tangent_stiffness"],
                      rigidity=float(d["rigidity"]), lost_motion=float(d["lost_motion"]),
-                     backlash=float(d["backlash"]))
+                     backlash=float(d["backlash"]), friction=bool(d["friction"]))
+
+
+def running_friction(scene: Scene, torque: float | None = None, points: int = 24, *,
+                     start: float = 0.0) -> dict[str, np.ndarray | float]:
+    """Quasi-static running sweeps with the scene's friction over one mesh period at ``points``
+    crank angles: every contact slides as in the running reducer, the input driving against
+    ``+torque`` (forward) and ``-torque`` (reverse) [N m]. Returns ``crank_angle`` [rad], TE
+    ``forward`` / ``reverse`` [rad], the held input's torque ``input_forward`` /
+    ``input_reverse`` [N m] and the mean quasi-static ``efficiency`` ``T / (i T_in)`` of each
+    direction (docs/model.md, "Friction in the LTCA")."""
+    sc = _scene(scene)
+    t = abs(_rated(sc, torque))
+    if int(points) < 1:
+        raise ParameterError(f"points must be at least 1, got {points}")
+    solver = _core.LtcaSolver(sc._compiled, 1e-12)
+    period = float(solver.mesh_period)
+    angles = _float("start", start, "rad") + period * np.arange(int(points)) / int(points)
+    fwd = solver.friction_sweep(t, angles.tolist())
+    rev = solver.friction_sweep(-t, angles.tolist())
+    i = float(solver.ratio)
+    return {"crank_angle": angles, "forward": fwd["transmission_error"],
+            "reverse": rev["transmission_error"], "input_forward": fwd["input_torque"],
+            "input_reverse": rev["input_torque"],
+            "efficiency_forward": float(np.mean(t / (i * fwd["input_torque"]))),
+            "efficiency_reverse": float(np.mean(-t / (i * rev["input_torque"])))}

@@ -184,6 +184,9 @@ class Sensitivity:
     values: tuple[float, ...]
     r2: float = math.nan
     total: tuple[float, ...] = ()
+    #: Sobol only: per name, the bootstrap confidence interval of the first-order and of the
+    #: total index, ``(first_low, first_high, total_low, total_high)``.
+    intervals: tuple[tuple[float, float, float, float], ...] = ()
 
     def top(self, k: int = 3) -> list[tuple[str, float]]:
         return list(zip(self.names, self.values))[:k]
@@ -221,11 +224,13 @@ def src(table: Any, metric: str, inputs: Sequence[str] | None = None) -> Sensiti
 
 
 def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: str, *, seed: int | None = 0,
-          runner: Any = None, kernel_options: dict[str, Any] | None = None, batch_size: int = 1) -> Sensitivity:
+          runner: Any = None, kernel_options: dict[str, Any] | None = None, batch_size: int = 1,
+          confidence: float | None = 0.95, n_resamples: int = 999) -> Sensitivity:
     """First-order Sobol indices of ``metric`` (ranked; ``total`` holds the total indices in
     the same order) from a Saltelli design of ``n`` base samples (a power of 2): the kernel
-    runs n (d + 2) times on ``runner``. Independent tolerances only; a failed sample makes the
-    estimate NaN."""
+    runs n (d + 2) times on ``runner``. ``intervals`` holds percentile-bootstrap confidence
+    intervals at level ``confidence`` (None: none) from ``n_resamples`` resamples. Independent
+    tolerances only; a failed sample makes the estimate NaN (and leaves out the intervals)."""
     from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     from .kernels import get_kernel
@@ -236,6 +241,8 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
 
     if isinstance(n, bool) or not isinstance(n, int) or n < 2 or n & (n - 1):
         raise ParameterError(f"sobol: n must be a power of 2 >= 2, got {n!r}")
+    if confidence is not None and not 0 < confidence < 1:
+        raise ParameterError(f"sobol: confidence must lie in (0, 1) or be None, got {confidence!r}")
     k = get_kernel(kernel, **(kernel_options or {}))
     layout = expand(scene, tolerances)
     metrics = getattr(k, "metrics", None)
@@ -271,5 +278,14 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
     total = np.asarray(res.total_order).ravel()
     names = [layout.variables[j].column for j in keep]
     order = np.argsort(-np.abs(first), kind="stable")
+    intervals: tuple[tuple[float, float, float, float], ...] = ()
+    if confidence is not None and np.all(np.isfinite(first)) and np.all(np.isfinite(total)):
+        # Percentile bootstrap over the Saltelli design's rows (SciPy's SobolResult.bootstrap).
+        boot = res.bootstrap(confidence_level=confidence, n_resamples=n_resamples)
+        f_ci = boot.first_order.confidence_interval
+        t_ci = boot.total_order.confidence_interval
+        lo_f, hi_f = np.asarray(f_ci.low).ravel(), np.asarray(f_ci.high).ravel()
+        lo_t, hi_t = np.asarray(t_ci.low).ravel(), np.asarray(t_ci.high).ravel()
+        intervals = tuple((float(lo_f[i]), float(hi_f[i]), float(lo_t[i]), float(hi_t[i])) for i in order)
     return Sensitivity(metric, "sobol", tuple(names[i] for i in order), tuple(float(first[i]) for i in order),
-                       total=tuple(float(total[i]) for i in order))
+                       total=tuple(float(total[i]) for i in order), intervals=intervals)

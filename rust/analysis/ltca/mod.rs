@@ -12,6 +12,7 @@
 //! `T` is the forward drive.
 
 pub mod export;
+pub mod friction;
 mod gear_errors;
 pub mod newton;
 pub mod statics;
@@ -22,9 +23,9 @@ use crate::contact::hertz::{Material, hertz_line_contact};
 use crate::dynamics::scene::Scene;
 use crate::error::{Result, RvdynError, require_finite};
 pub use newton::{NewtonOptions, NewtonReport};
-use newton::{equilibrium, solve_dense};
+use newton::{Scratch, equilibrium, solve_dense};
 use serde::Serialize;
-use statics::{CARRIER, ContactState, Dense, Statics, Work};
+use statics::{CARRIER, Statics, Work};
 
 /// One arc minute [rad].
 pub const ARCMIN: f64 = PI / (180.0 * 60.0);
@@ -166,6 +167,10 @@ pub struct Ltca {
     statics: Statics,
     options: NewtonOptions,
     work: Work,
+    /// Newton's scratch space, with the contact state at the last solution.
+    scratch: Scratch,
+    /// Keep the contact state of the next solution (for its report).
+    capture: bool,
     /// Last solution `(psi, q)`: the warm start of the next.
     last: Option<Solved>,
     /// The solution before the last: with the last, a linear predictor.
@@ -174,6 +179,8 @@ pub struct Ltca {
     face_width: f64,
     ratio: f64,
     mesh_period: f64,
+    /// The scene's friction (as the dynamic models apply it; `friction`).
+    friction: friction::FrictionLaws,
 }
 
 impl Ltca {
@@ -195,12 +202,15 @@ impl Ltca {
         Ok(Self {
             options,
             work: Work::new(),
+            scratch: Scratch::default(),
+            capture: false,
             last: None,
             before: None,
             k_ref,
             face_width: scene.cycloid.face_width,
             ratio: scene.ratio(),
             mesh_period: mesh_period(scene),
+            friction: friction::FrictionLaws::new(scene),
             statics,
         })
     }
@@ -213,6 +223,11 @@ impl Ltca {
     /// Transmission ratio input/output.
     pub fn ratio(&self) -> f64 {
         self.ratio
+    }
+
+    /// Force evaluations (static forces with their tangent) made so far (for benchmarks).
+    pub fn evaluations(&self) -> usize {
+        self.statics.evaluations
     }
 
     /// The unknowns of the last equilibrium found (empty before the first).
@@ -276,6 +291,8 @@ impl Ltca {
             self.k_ref,
             &self.options,
             &mut self.work,
+            &mut self.scratch,
+            self.capture,
         ) {
             Ok(r) => r,
             Err(e) if self.last.is_some() => {
@@ -290,6 +307,8 @@ impl Ltca {
                     self.k_ref,
                     &self.options,
                     &mut self.work,
+                    &mut self.scratch,
+                    self.capture,
                 )?;
                 q = q2;
                 r
@@ -309,7 +328,11 @@ impl Ltca {
     /// [N m]. Errors: non-finite input (`Parameter`); no equilibrium found or a penetration
     /// beyond a tenth of the pin radius (`Convergence`, naming the crank angle and residual).
     pub fn solve(&mut self, torque: f64, psi: f64) -> Result<LtcaPoint> {
-        let (q, rep) = self.solve_unknowns(torque, psi)?;
+        // The report reuses the contact state of Newton's evaluation at the solution.
+        self.capture = true;
+        let solved = self.solve_unknowns(torque, psi);
+        self.capture = false;
+        let (q, rep) = solved?;
         self.point(torque, psi, &q, rep)
     }
 
@@ -348,22 +371,13 @@ impl Ltca {
     fn point(&mut self, torque: f64, psi: f64, q: &[f64], rep: NewtonReport) -> Result<LtcaPoint> {
         let st = &mut self.statics;
         let n = st.dim();
-        let mut r = vec![0.0; n];
-        let mut k = Dense::zeros(n);
-        let mut cs = ContactState::default();
-        // Fresh gaps of every pin for the report (no separation skipping).
-        st.exact = true;
-        let evaluated = st.eval(
-            psi,
-            q,
-            torque,
-            &mut r,
-            &mut k,
-            &mut self.work,
-            Some(&mut cs),
-        );
-        st.exact = false;
-        evaluated?;
+        // Newton's last evaluation is at the solution: its forces, its stiffness
+        // (`work.k_last`) and its contact state, with fresh gaps of the pins the separation
+        // bound skipped there (no force either way).
+        let x = st.full(psi, q);
+        let mut cs = std::mem::take(&mut self.scratch.state);
+        st.refresh_skipped_jets(&x, &mut cs)?;
+        let mut k = self.work.k_last.clone();
         let mut e0 = vec![0.0; n];
         e0[0] = 1.0;
         let stiff = if solve_dense(&mut k, &mut e0) && e0[0] > 0.0 {
@@ -371,7 +385,6 @@ impl Ltca {
         } else {
             0.0
         };
-        let x = st.full(psi, q);
         let kin = st.kinematic_full(psi);
         let m = &st.model;
         let zp = m.pins.len();
@@ -547,8 +560,29 @@ impl Ltca {
 
     /// The torque-twist loop at crank angle `psi`: `points` torques along
     /// 0 -> +rated -> -rated -> 0 with rigidity, lost motion and backlash (catalogue
-    /// definitions, docs/model.md).
+    /// definitions, docs/model.md), with the scene's friction if it has any.
     pub fn twist_loop(&mut self, rated: f64, psi: f64, points: usize) -> Result<TwistLoop> {
+        self.twist_loop_with(rated, psi, points, true)
+    }
+
+    /// The scene's friction laws as the LTCA applies them.
+    pub fn friction_laws(&self) -> &friction::FrictionLaws {
+        &self.friction
+    }
+
+    /// As [`Ltca::twist_loop`]; `friction = false` ignores the scene's friction (the closed
+    /// loop of the frictionless reducer).
+    pub fn twist_loop_with(
+        &mut self,
+        rated: f64,
+        psi: f64,
+        points: usize,
+        friction: bool,
+    ) -> Result<TwistLoop> {
+        if friction && self.friction.any() {
+            let laws = self.friction.clone();
+            return self.twist_loop_with_friction(&laws, rated, psi, points);
+        }
         require_finite("rated torque", rated)?;
         let rated = rated.abs();
         if rated == 0.0 || points < 8 {

@@ -25,7 +25,7 @@ use super::gear_errors::FlankError;
 use crate::contact::ImpactLaw;
 use crate::contact::law::{MeshLaw, PinLaw};
 use crate::contact::pin_tangent::{
-    GapJet, centre_curve_derivatives_cs, foot_jet_with, gap_jet_cs, line_jet, line_jet_with,
+    GapJet, centre_curve_derivatives_cs, foot_jet_with, gap_jet_cs, line_jet, line_jet_checked,
 };
 use crate::dynamics::model::laws::{BearingLaw, ContactLaw};
 use crate::dynamics::rigid::RigidModel;
@@ -57,7 +57,7 @@ fn cos_sin(a: f64) -> [f64; 2] {
 }
 
 /// A dense symmetric-by-construction matrix of size `n` (row-major).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Dense {
     /// Size.
     pub n: usize,
@@ -681,7 +681,8 @@ impl Statics {
                                 Some((cd, ..)) => *cd,
                                 None => centre_curve_derivatives_cs(&d.geometry, jet.phi_cos_sin),
                             };
-                            let lj = line_jet_with(
+                            // Materials, pin radius and depth were checked with the scene.
+                            let lj = line_jet_checked(
                                 &d.geometry,
                                 &cd,
                                 pen,
@@ -825,7 +826,7 @@ impl Statics {
                         kf.sym(CARRIER, ci, -f * zw[0]);
                         kf.sym(CARRIER, ci + 1, -f * zw[1]);
                         if let Some(g) = &ge {
-                            g.add_curvature(kf, ci, -f);
+                            g.add_curvature(kf, ci, f);
                         }
                     }
                     f_report += sigma * f;
@@ -998,15 +999,28 @@ impl Statics {
         for (a, col) in work.jac.iter().enumerate() {
             r[a] = col.iter().map(|&(i, v)| v * qf[i]).sum();
         }
+        // A column that is one full coordinate with weight 1 takes its entries as they are.
+        let single = |c: &[(usize, f64)]| match c {
+            [(i, v)] if *v == 1.0 => Some(*i),
+            _ => None,
+        };
         for a in 0..n {
+            let ja = &work.jac[a];
+            let sa = single(ja);
             for b in 0..n {
-                let mut s = 0.0;
-                for &(i, vi) in &work.jac[a] {
-                    for &(j, vj) in &work.jac[b] {
-                        s += vi * kf.at(i, j) * vj;
+                let jb = &work.jac[b];
+                k.a[a * n + b] = match (sa, single(jb)) {
+                    (Some(i), Some(j)) => kf.at(i, j),
+                    _ => {
+                        let mut s = 0.0;
+                        for &(i, vi) in ja {
+                            for &(j, vj) in jb {
+                                s += vi * kf.at(i, j) * vj;
+                            }
+                        }
+                        s
                     }
-                }
-                k.a[a * n + b] = s;
+                };
             }
         }
         // Curvature of the map: slaved crank centres p_i = s_i(th_c) (hess = -s_i) and, for
@@ -1028,6 +1042,14 @@ impl Statics {
             k.a[n + 1] += extra;
         }
         Ok(())
+    }
+
+    /// `out = J^T v` of a full-coordinate force `v` with the map Jacobian of the last
+    /// [`Statics::eval`] (the friction forces of `ltca::friction`).
+    pub fn reduce_force(&self, v: &[f64], work: &Work, out: &mut [f64]) {
+        for (o, col) in out.iter_mut().zip(&work.jac) {
+            *o = col.iter().map(|&(i, c)| c * v[i]).sum();
+        }
     }
 
     /// `J^T A J` of a full-coordinate matrix `a` with the map Jacobian of the last
@@ -1059,6 +1081,54 @@ impl Statics {
                 .map(|i| work.qf[self.crank_index(i) + 2])
                 .sum::<f64>()
         }
+    }
+
+    /// Fresh gaps (with the disc's profile error) in `cs` of the pins that the last
+    /// [`Statics::eval`], at the full coordinates `x`, skipped by the separation bound (which
+    /// proves them open: no force); the pins it queried keep their jets. For reports: the same
+    /// gaps as an evaluation with `exact` set. Errors as [`Statics::full_forces`].
+    pub(crate) fn refresh_skipped_jets(&mut self, x: &[f64], cs: &mut ContactState) -> Result<()> {
+        let m = &self.model;
+        let zp = m.pins.len();
+        if !self.skip || cs.pin_jet.len() != m.discs.len() * zp {
+            return Ok(());
+        }
+        for (k, d) in m.discs.iter().enumerate() {
+            let dk = self.disc_index(k);
+            let o = [x[dk], x[dk + 1]];
+            let th = x[dk + 2];
+            let cs_th = cos_sin(th);
+            for (j, pin) in m.pins.iter().enumerate() {
+                let slot = k * zp + j;
+                let b = &self.separation[slot];
+                if b.0 == o && b.1 == th && b.2.is_finite() {
+                    continue;
+                }
+                let kin = pin.angle - th - d.geometry.params().d_delta;
+                let w = &mut self.warm[slot];
+                let jet = gap_jet_cs(
+                    &d.geometry,
+                    pin.centre,
+                    pin.radius,
+                    o,
+                    cs_th,
+                    kin + *w,
+                    None,
+                )
+                .ok_or_else(|| no_foot(k, j))?;
+                let off = jet.phi - kin;
+                *w = if off.abs() < 0.01 { off } else { 0.0 };
+                self.separation[slot] = (o, th, jet.gap - self.error_bound[k]);
+                self.last_jets[slot] = jet;
+                let mut e = jet;
+                if let Some(pe) = &d.profile_error {
+                    e.gap -= pe.offset(jet.phi).0;
+                }
+                cs.pin_gap[slot] = e.gap;
+                cs.pin_jet[slot] = e;
+            }
+        }
+        Ok(())
     }
 }
 

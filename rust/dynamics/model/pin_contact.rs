@@ -40,6 +40,68 @@ pub(crate) struct WarmStart {
     /// `ln F` of the line law's force at that evaluation (its inversion's warm start; NaN
     /// when unknown).
     pub(crate) ln_force: f64,
+    /// Signed gap [m] at that evaluation (`+inf` before the first).
+    pub(crate) gap: f64,
+    /// The gap at the last accepted step end ([`mark_open`]): a pin open there that touches
+    /// at the next evaluation closed within the step.
+    pub(crate) marked_gap: f64,
+}
+
+/// The depth [m] a first touch may reach within one integrator step under `law`: the IMPACT
+/// law's damping ramp `d` (a step that closes deeper jumps the damping from 0 to `cmax`, the
+/// failure a ramp exists to prevent). `None` for laws whose force and damping rise
+/// continuously from zero approach (the line law), where the error estimate covers first touch.
+pub(crate) fn first_touch_allowance(law: &PinLaw) -> Option<f64> {
+    match law {
+        PinLaw::Impact(l) => Some(l.damping_depth),
+        PinLaw::Line { .. } => None,
+    }
+}
+
+/// [`deepest_first_touch`] for a model's law, with the pin named as in its errors.
+pub(crate) fn first_touch_report(
+    seeds: &[Cell<WarmStart>],
+    law: &PinLaw,
+    pins_per_disc: usize,
+) -> Option<(f64, String)> {
+    let allowed = first_touch_allowance(law)?;
+    let (r, i) = deepest_first_touch(seeds, allowed)?;
+    Some((
+        r,
+        format!(
+            "pin {} on disc {} (first touch {:.3e} m deep, its law's damping ramp is {:.3e} m)",
+            i % pins_per_disc + 1,
+            i / pins_per_disc,
+            r * allowed,
+            allowed
+        ),
+    ))
+}
+
+/// Remember which pins are open at the state just evaluated (an integrator's accepted step).
+pub(crate) fn mark_open(seeds: &[Cell<WarmStart>]) {
+    for w in seeds {
+        let mut ws = w.get();
+        ws.marked_gap = ws.gap;
+        w.set(ws);
+    }
+}
+
+/// The deepest first touch since [`mark_open`], over `allowed` [m]: the largest penetration of
+/// a pin open at the mark and touching at the last evaluation, divided by `allowed`, with the
+/// pin's index (disc-major, as the seeds). `None` if no pin closed.
+pub(crate) fn deepest_first_touch(seeds: &[Cell<WarmStart>], allowed: f64) -> Option<(f64, usize)> {
+    let mut worst: Option<(f64, usize)> = None;
+    for (i, w) in seeds.iter().enumerate() {
+        let ws = w.get();
+        if ws.marked_gap > 0.0 && ws.gap < 0.0 {
+            let r = -ws.gap / allowed;
+            if worst.is_none_or(|(b, _)| r > b) {
+                worst = Some((r, i));
+            }
+        }
+    }
+    worst
 }
 
 impl Default for WarmStart {
@@ -50,6 +112,8 @@ impl Default for WarmStart {
             kinematic: f64::NAN,
             cos_sin: [1.0, 0.0],
             ln_force: f64::NAN,
+            gap: f64::INFINITY,
+            marked_gap: f64::INFINITY,
         }
     }
 }
@@ -135,12 +199,6 @@ pub(crate) fn pin_query(
             labels.0
         ))
     })?;
-    warm.set(WarmStart {
-        phi: foot.phi,
-        kinematic,
-        cos_sin: foot.cos_sin,
-        ln_force: w.ln_force,
-    });
     let r_gen = g.generating_pin_radius();
     let mut gap = foot.dist + r_gen - pin.radius;
     // Profile error: the ground profile offset by delta(phi) along its normal shrinks the gap
@@ -163,6 +221,14 @@ pub(crate) fn pin_query(
             [-k * t_global[0], -k * t_global[1]],
             -k * (j.d1[0] * zxp[0] + j.d1[1] * zxp[1]),
         )
+    });
+    warm.set(WarmStart {
+        phi: foot.phi,
+        kinematic,
+        cos_sin: foot.cos_sin,
+        ln_force: w.ln_force,
+        gap,
+        marked_gap: w.marked_gap,
     });
     let nl = g.apply_rotation_mod(foot.normal);
     let pl = g.apply_rotation_mod([

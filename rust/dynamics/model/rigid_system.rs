@@ -1,6 +1,7 @@
 //! The rigid-joint model seen by the integrators: free coordinates only.
 
 use crate::dynamics::model::parts::ShaftLoads;
+use crate::dynamics::model::pin_contact::{first_touch_report, mark_open};
 use crate::dynamics::model::rigid::{CARRIER, CRANK, FULL, Forces, LOAD, MOTOR, RigidModel, SUN};
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
 use crate::dynamics::run::sink::{ContactSink, DynSink, NoSink};
@@ -142,6 +143,15 @@ impl MechanicalSystem for RigidSystem<'_> {
 
     fn length_scale(&self) -> &[f64] {
         &self.scale
+    }
+
+    fn mark_open_contacts(&self) {
+        mark_open(&self.model.warm_seeds);
+    }
+
+    fn deepest_first_touch(&self) -> Option<(f64, String)> {
+        let m = self.model;
+        first_touch_report(&m.warm_seeds, &m.pin_law, m.pins.len())
     }
 }
 

@@ -44,7 +44,9 @@ use crate::bearing::PalmgrenFriction;
 use crate::dynamics::model::laws::BearingLaw;
 pub use crate::dynamics::model::laws::{BearingLoad, linear_bearing as bearing_load};
 use crate::dynamics::model::parts::Parts;
-use crate::dynamics::model::pin_contact::{SeparationBound, WarmStart};
+use crate::dynamics::model::pin_contact::{
+    SeparationBound, WarmStart, first_touch_report, mark_open,
+};
 use crate::dynamics::model::vec2::{add, perp, rotate, scaled, sub};
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
 use crate::dynamics::run::sink::{ContactSink, DynSink, NoSink};
@@ -524,6 +526,15 @@ impl MechanicalSystem for CompliantModel {
 
     fn length_scale(&self) -> &[f64] {
         &self.scale
+    }
+
+    fn mark_open_contacts(&self) {
+        mark_open(&self.warm_seeds);
+    }
+
+    fn deepest_first_touch(&self) -> Option<(f64, String)> {
+        let m = &self.parts;
+        first_touch_report(&self.warm_seeds, &m.pin_law, m.pins.len())
     }
 }
 
