@@ -13,6 +13,7 @@
 
 pub mod export;
 pub mod friction;
+mod gear_errors;
 pub mod newton;
 pub mod statics;
 
@@ -709,7 +710,9 @@ impl Ltca {
 /// which the held sun passes every `2 pi zc / (z_planet zp)` of crank angle
 /// (`th_s - th_c = -(z_planet / z_sun)(1 + 1/zc) psi` with the input held): the pattern then
 /// repeats after the least common multiple of both periods, counted in units of
-/// `2 pi / (z_planet zp)`.
+/// `2 pi / (z_planet zp)`. Gear runout and pitch errors repeat only after a whole turn of the
+/// sun relative to the carrier (`z_sun zc` units) or of a planet (`z_planet zc` units): the
+/// window is then the least common multiple with those too.
 pub fn mesh_period(scene: &Scene) -> f64 {
     let e = &scene.pin_errors;
     let errors =
@@ -735,12 +738,14 @@ pub fn mesh_period(scene: &Scene) -> f64 {
         scene.contact.mesh,
         crate::dynamics::scene::ContactLawSpec::Iso6336 { .. }
     );
-    match (&scene.stage1, iso) {
+    // Gear errors repeat after whole turns of the sun and planets (gear_errors.rs).
+    let gear_units = gear_errors::period_units(scene);
+    match (&scene.stage1, iso || gear_units > 1) {
         (Some(st), true) => {
             let zpl = u64::from(st.z_planet);
             let unit = TAU / (zpl * zp) as f64;
             let pin_units = zpl * pitches;
-            let mesh_units = zp - 1;
+            let mesh_units = gear_errors::lcm(if iso { zp - 1 } else { 1 }, gear_units);
             let gcd = |mut a: u64, mut b: u64| {
                 while b != 0 {
                     (a, b) = (b, a % b);
