@@ -92,7 +92,8 @@ def main() -> None:
     for metric, stats in describe(table, ["te_pp_forward", "peak_pin_force"]).items():
         print(metric, {k: (round(v.value, 9), round(v.low, 9), round(v.high, 9)) if hasattr(v, "value") else v
                        for k, v in stats.items()})
-    print(f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB")
+    print(f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB (driver), "
+          f"{resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024:.0f} MiB (largest worker process)")
 
 
 if __name__ == "__main__":

@@ -100,5 +100,3 @@ def test_physical_bad_input_is_a_clear_error() -> None:
         ltca(scene, RATED, [float("nan")])
     with pytest.raises(rvdyn.ConvergenceError, match="crank angle"):
         ltca(scene, 1e9, [0.1])
-    with pytest.raises(rvdyn.SceneError, match="gear_errors"):
-        ltca(scene.replace(**{"gear_errors.sun.runout": 1e-6}), RATED, [0.0])

@@ -13,6 +13,7 @@
 
 pub mod export;
 pub mod friction;
+mod gear_errors;
 pub mod newton;
 pub mod statics;
 
@@ -168,6 +169,8 @@ pub struct Ltca {
     work: Work,
     /// Newton's scratch space, with the contact state at the last solution.
     scratch: Scratch,
+    /// The unknowns whose contact state `scratch` holds for a report (empty: none).
+    captured_q: Vec<f64>,
     /// Keep the contact state of the next solution (for its report).
     capture: bool,
     /// Last solution `(psi, q)`: the warm start of the next.
@@ -202,6 +205,7 @@ impl Ltca {
             options,
             work: Work::new(),
             scratch: Scratch::default(),
+            captured_q: Vec::new(),
             capture: false,
             last: None,
             before: None,
@@ -332,6 +336,7 @@ impl Ltca {
         let solved = self.solve_unknowns(torque, psi);
         self.capture = false;
         let (q, rep) = solved?;
+        self.captured_q.clone_from(&q);
         self.point(torque, psi, &q, rep)
     }
 
@@ -374,9 +379,31 @@ impl Ltca {
         // (`work.k_last`) and its contact state, with fresh gaps of the pins the separation
         // bound skipped there (no force either way).
         let x = st.full(psi, q);
-        let mut cs = std::mem::take(&mut self.scratch.state);
-        st.refresh_skipped_jets(&x, &mut cs)?;
-        let mut k = self.work.k_last.clone();
+        let captured = std::mem::take(&mut self.captured_q);
+        let (cs, mut k) = if captured.as_slice() == q {
+            let mut cs = std::mem::take(&mut self.scratch.state);
+            st.refresh_skipped_jets(&x, &mut cs)?;
+            (cs, self.work.k_last.clone())
+        } else {
+            // Not the state Newton just captured (another caller's unknowns): evaluate afresh,
+            // every pin queried.
+            let mut r = vec![0.0; n];
+            let mut k = statics::Dense::zeros(n);
+            let mut cs = statics::ContactState::default();
+            st.exact = true;
+            let evaluated = st.eval(
+                psi,
+                q,
+                torque,
+                &mut r,
+                &mut k,
+                &mut self.work,
+                Some(&mut cs),
+            );
+            st.exact = false;
+            evaluated?;
+            (cs, k)
+        };
         let mut e0 = vec![0.0; n];
         e0[0] = 1.0;
         let stiff = if solve_dense(&mut k, &mut e0) && e0[0] > 0.0 {
@@ -683,7 +710,9 @@ impl Ltca {
 /// which the held sun passes every `2 pi zc / (z_planet zp)` of crank angle
 /// (`th_s - th_c = -(z_planet / z_sun)(1 + 1/zc) psi` with the input held): the pattern then
 /// repeats after the least common multiple of both periods, counted in units of
-/// `2 pi / (z_planet zp)`.
+/// `2 pi / (z_planet zp)`. Gear runout and pitch errors repeat only after a whole turn of the
+/// sun relative to the carrier (`z_sun zc` units) or of a planet (`z_planet zc` units): the
+/// window is then the least common multiple with those too.
 pub fn mesh_period(scene: &Scene) -> f64 {
     let e = &scene.pin_errors;
     let errors =
@@ -709,12 +738,14 @@ pub fn mesh_period(scene: &Scene) -> f64 {
         scene.contact.mesh,
         crate::dynamics::scene::ContactLawSpec::Iso6336 { .. }
     );
-    match (&scene.stage1, iso) {
+    // Gear errors repeat after whole turns of the sun and planets (gear_errors.rs).
+    let gear_units = gear_errors::period_units(scene);
+    match (&scene.stage1, iso || gear_units > 1) {
         (Some(st), true) => {
             let zpl = u64::from(st.z_planet);
             let unit = TAU / (zpl * zp) as f64;
             let pin_units = zpl * pitches;
-            let mesh_units = zp - 1;
+            let mesh_units = gear_errors::lcm(if iso { zp - 1 } else { 1 }, gear_units);
             let gcd = |mut a: u64, mut b: u64| {
                 while b != 0 {
                     (a, b) = (b, a % b);

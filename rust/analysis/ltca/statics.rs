@@ -21,6 +21,7 @@
 
 use std::f64::consts::TAU;
 
+use super::gear_errors::FlankError;
 use crate::contact::ImpactLaw;
 use crate::contact::law::{MeshLaw, PinLaw};
 use crate::contact::pin_tangent::{
@@ -233,19 +234,6 @@ pub struct Statics {
 impl Statics {
     /// Build from a scene (validated by the model).
     pub fn new(scene: &Scene) -> Result<Self> {
-        // Errors the statics do not model yet: say so rather than analyse another reducer.
-        let unsupported = if scene.gear_errors.any() {
-            Some("gear runout and pitch errors (gear_errors)")
-        } else {
-            None
-        };
-        if let Some(what) = unsupported {
-            return Err(RvdynError::Scene(format!(
-                "the quasi-static analysis (LTCA, modes) does not include {what} yet: remove \
-                 them from the scene for this analysis (pin errors, disc profile errors, \
-                 assembly errors and profile modifications are included)"
-            )));
-        }
         if scene.errors.any() && matches!(scene.joints, Joints::Rigid) {
             return Err(RvdynError::Scene(
                 "assembly errors (errors: crank eccentricity and phase, disc holes, carrier \
@@ -786,13 +774,20 @@ impl Statics {
                 // Mesh position along the line of action (the dynamic models' `s`).
                 let s_mesh = rbs * (x[SUN] - thc) + mm.phases[i] * mm.base_pitch;
                 let mut f_report = 0.0;
+                let mut e_drive = 0.0;
                 for sigma in [1.0, -1.0] {
+                    // Gear runout and pitch errors: the flank's extra approach E.
+                    let ge = FlankError::at(m.mesh_errors.as_ref(), i, sigma, thc, x[SUN], alpha);
+                    let e = ge.map_or(0.0, |g| g.value);
+                    if sigma > 0.0 {
+                        e_drive = e;
+                    }
                     let w = [
                         sp * u[0] + sigma * cp * zu[0],
                         sp * u[1] + sigma * cp * zu[1],
                     ];
                     let zw = perp(w);
-                    let pen = sigma * rot - dot(dcr, w) - half;
+                    let pen = sigma * rot - dot(dcr, w) - half + e;
                     self.max_penetration = self.max_penetration.max(pen);
                     // V = k(s') pen^2 / 2 for the ISO wave at the flank's position
                     // s' = sigma s: force, stiffness, V_s, V_pen,s, V_ss, damping coefficient.
@@ -802,13 +797,16 @@ impl Statics {
                         MeshStatic::default()
                     };
                     let (f, fp) = (ms.force, ms.stiffness);
-                    let grad = [
+                    let mut grad = [
                         sigma * rbs,
                         -sigma * (rbs + rbp) + dot(perp(s), w) - dot(dcr, zw),
                         sigma * rbp,
                         -w[0],
                         -w[1],
                     ];
+                    if let Some(g) = &ge {
+                        g.add_gradient(&mut grad);
+                    }
                     if let Some(c) = cf.as_mut()
                         && on(Family::Mesh)
                     {
@@ -827,13 +825,17 @@ impl Statics {
                         kf.add(CARRIER, CARRIER, f * dot(p, w));
                         kf.sym(CARRIER, ci, -f * zw[0]);
                         kf.sym(CARRIER, ci + 1, -f * zw[1]);
+                        if let Some(g) = &ge {
+                            g.add_curvature(kf, ci, f);
+                        }
                     }
                     f_report += sigma * f;
                 }
                 if let Some(st) = state.as_deref_mut() {
                     st.mesh_force.push(f_report);
-                    st.mesh_deflection
-                        .push(rot - dot(dcr, [sp * u[0] + cp * zu[0], sp * u[1] + cp * zu[1]]));
+                    st.mesh_deflection.push(
+                        rot - dot(dcr, [sp * u[0] + cp * zu[0], sp * u[1] + cp * zu[1]]) + e_drive,
+                    );
                 }
             }
             // Crank bearing: d = p - s_act(th_c) (the actual seat, with its error).

@@ -424,6 +424,12 @@ impl GearModelError {
         let (t, ts) = crate::geometry::cycloid::periodic_table(&self.table, psi);
         (self.pitch_amplitude * s + t, self.pitch_amplitude * c + ts)
     }
+
+    /// Second derivative of the cumulative pitch deviation [m/rad^2] at body angle `psi`:
+    /// the sinusoid's (the table is linear between teeth).
+    fn pitch_curvature(&self, psi: f64) -> f64 {
+        -self.pitch_amplitude * (psi + self.pitch_phase).sin()
+    }
 }
 
 /// Extra approach of one mesh flank [m] and its derivatives by the carrier, sun and crank
@@ -486,6 +492,52 @@ impl MeshErrors {
             sun: -k * fs1 - es * ss,
             crank: -k * fp1 + ep * sp,
         }
+    }
+
+    /// Hessian of [`MeshErrors::offset`] by (carrier, sun, crank) angles [m/rad^2] (the
+    /// quasi-static tangent's curvature term; a pitch table is linear between teeth).
+    pub(crate) fn offset_hessian(
+        &self,
+        i: usize,
+        sign: f64,
+        thc: f64,
+        ths: f64,
+        alpha: f64,
+    ) -> [[f64; 3]; 3] {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let g = self.gamma[i];
+        let p = &self.planets[i];
+        let psi = thc + g + sign * (FRAC_PI_2 - self.pressure_angle);
+        let k = sign * self.cos_pa;
+        // Each term is a function of one combination of the angles with gradient `u`:
+        // its Hessian is (second derivative) u u^T.
+        let terms = [
+            (
+                k * self.sun.pitch_curvature(thc + g - ths),
+                [1.0, -1.0, 0.0],
+            ),
+            (
+                k * p.pitch_curvature(thc + g + PI - alpha),
+                [1.0, 0.0, -1.0],
+            ),
+            (
+                -self.sun.runout * (ths + self.sun.runout_phase - psi).cos(),
+                [-1.0, 1.0, 0.0],
+            ),
+            (
+                p.runout * (alpha + p.runout_phase - psi).cos(),
+                [-1.0, 0.0, 1.0],
+            ),
+        ];
+        let mut h = [[0.0; 3]; 3];
+        for (c, u) in terms {
+            for (a, row) in h.iter_mut().enumerate() {
+                for (b, v) in row.iter_mut().enumerate() {
+                    *v += c * u[a] * u[b];
+                }
+            }
+        }
+        h
     }
 }
 

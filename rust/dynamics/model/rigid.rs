@@ -469,6 +469,57 @@ impl RigidModel {
         out
     }
 
+    /// Reactions of the ideal crank (main) bearings on the cranks [N] (fixed frame), from each
+    /// crank's balance (docs/model.md#bearing-reactions-of-ideal-joints):
+    /// `B_i = m_cr p_i'' + sum_k R_ik - F_mesh,i`, with the crank centre's acceleration
+    /// `p_i'' = r_cr ((z x u_i) th_c'' - u_i th_c'^2)` (`u_i` the crank's direction; the
+    /// carrier's kinematics), `R_ik` the eccentric reactions on the discs
+    /// ([`RigidModel::eccentric_reactions`], index `i * discs + k`) and the mesh force on planet
+    /// `i`: `|f| sin(pa) u_i + f cos(pa) (z x u_i)` for the signed force `f` along the line of
+    /// action (positive on the drive flank; `mesh_force`, one per crank, empty without a first
+    /// stage). Tooth friction (torques only in this model) is not included.
+    pub(crate) fn crank_reactions(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        a: &[f64],
+        eccentric: &[[f64; 2]],
+        mesh_force: &[f64],
+    ) -> Vec<[f64; 2]> {
+        let n = self.cranks;
+        let nd = self.discs.len();
+        let mc = self.inertias.crank.mass;
+        let r = self.crank_radius;
+        // Pressure angle from the line of action's length between the tangency points,
+        // `T1T2 = (r_bs + r_bp) tan(pa)`.
+        let (sp, cp) = match &self.mesh {
+            Some(mm) => (mm.path.t1t2 / (mm.sun_base_radius + mm.planet_base_radius))
+                .atan()
+                .sin_cos(),
+            None => (0.0, 0.0),
+        };
+        (0..n)
+            .map(|i| {
+                let g = std::f64::consts::TAU * i as f64 / n as f64 + x[CARRIER];
+                let (sg, cg) = g.sin_cos();
+                let (u, zu) = ([cg, sg], [-sg, cg]);
+                let (w, dw) = (v[CARRIER], a[CARRIER]);
+                let mut b = [
+                    mc * r * (zu[0] * dw - u[0] * w * w),
+                    mc * r * (zu[1] * dw - u[1] * w * w),
+                ];
+                for e in &eccentric[i * nd..(i + 1) * nd] {
+                    b[0] += e[0];
+                    b[1] += e[1];
+                }
+                let f = mesh_force.get(i).copied().unwrap_or(0.0);
+                b[0] -= f.abs() * sp * u[0] + f * cp * zu[0];
+                b[1] -= f.abs() * sp * u[1] + f * cp * zu[1];
+                b
+            })
+            .collect()
+    }
+
     /// Kinetic energy of the free bodies [J] (the prescribed input is a driver, not counted).
     pub(crate) fn kinetic_energy(&self, v: &[f64; FULL]) -> f64 {
         (0..FULL)

@@ -202,6 +202,11 @@ impl ReducerModel for RigidSystem<'_> {
     ) -> Result<Observation> {
         let m = self.model;
         let (x, xv, acc) = self.full(t, q, v);
+        // Keep each planet's mesh force for the crank reactions.
+        let sink = &mut MeshCapture {
+            inner: sink,
+            force: vec![0.0; m.cranks],
+        };
         let (f, qa, sh) = if sink.wants_forces() {
             if m.output_shaft.is_none() && m.input_shaft.is_none() {
                 // No shafts: the reducer's forces alone, called directly (as in `eval`).
@@ -241,8 +246,17 @@ impl ReducerModel for RigidSystem<'_> {
             if let Some(p) = m.prescribed {
                 xa[p] = acc;
             }
-            for (i, r) in m.eccentric_reactions(&x, &xv, &xa, &f).iter().enumerate() {
+            let ecc = m.eccentric_reactions(&x, &xv, &xa, &f);
+            for (i, r) in ecc.iter().enumerate() {
                 sink.bearing(1, i, *r);
+            }
+            let mesh_force = std::mem::take(&mut sink.force);
+            for (i, r) in m
+                .crank_reactions(&x, &xv, &xa, &ecc, &mesh_force)
+                .iter()
+                .enumerate()
+            {
+                sink.bearing(0, i, *r);
             }
         }
         let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = (0..m.discs.len())
@@ -290,5 +304,44 @@ impl ReducerModel for RigidSystem<'_> {
                 [0.0; 3]
             },
         })
+    }
+}
+
+/// A sink that passes everything on and keeps each mesh's force (for the crank reactions).
+struct MeshCapture<'a> {
+    inner: &'a mut dyn ContactSink,
+    force: Vec<f64>,
+}
+
+impl ContactSink for MeshCapture<'_> {
+    fn wants_energy(&self) -> bool {
+        self.inner.wants_energy()
+    }
+    fn wants_forces(&self) -> bool {
+        self.inner.wants_forces()
+    }
+    fn checks_bounds(&self) -> bool {
+        self.inner.checks_bounds()
+    }
+    fn pin(
+        &mut self,
+        k: usize,
+        j: usize,
+        force: f64,
+        pen: f64,
+        moment: f64,
+        point: [f64; 2],
+        normal: [f64; 2],
+    ) {
+        self.inner.pin(k, j, force, pen, moment, point, normal);
+    }
+    fn mesh(&mut self, i: usize, force: f64, deflection: f64) {
+        if let Some(f) = self.force.get_mut(i) {
+            *f = force;
+        }
+        self.inner.mesh(i, force, deflection);
+    }
+    fn bearing(&mut self, family: usize, index: usize, force: [f64; 2]) {
+        self.inner.bearing(family, index, force);
     }
 }
