@@ -1,9 +1,10 @@
-"""Tolerance-study throughput: samples/s of the dynamic kernel (0.5 s runs) on 1 and 2 workers
+"""Tolerance-study throughput: samples/s of the dynamic kernel (0.5 s runs) and of the LTCA
+kernel (physical preset, 8 times as many samples) on 1 and 2 workers
 for threads, processes and Dask; scheduling overhead per task; memory of a 100 000-sample
 study with a cheap kernel streamed to Parquet.
 
     python benches/study_throughput.py                # everything (a few minutes on 2 cores)
-    python benches/study_throughput.py --part memory  # one part: dynamic, overhead, memory
+    python benches/study_throughput.py --part memory  # one part: dynamic, ltca, overhead, memory
 
 Rates are medians over interleaved rounds (runner A, B, C, A, B, C, ...); pools and clusters
 are started and warmed up before timing (their start-up time is printed separately).
@@ -78,15 +79,25 @@ def _warm(_: Any) -> int:
     return os.getpid()
 
 
-def _timed(runner: Any, kernel: Any, n: int, seed: int, **kw: Any) -> float:
+def _timed(runner: Any, kernel: Any, n: int, seed: int, scene: Any = None, **kw: Any) -> float:
     t = time.perf_counter()
-    table = rvdyn.study(SCENE, kernel, TOLS, samples=MonteCarlo(n), seed=seed, runner=runner, **kw)
+    table = rvdyn.study(SCENE if scene is None else scene, kernel, TOLS, samples=MonteCarlo(n), seed=seed,
+                        runner=runner, **kw)
     wall = time.perf_counter() - t
     assert (table["error"] == "").all(), table["error"].unique()
     return wall
 
 
 def part_dynamic(n: int, rounds: int, t_end: float) -> dict[str, Any]:
+    return _part_kernel("dynamic", f"dynamic t_end {t_end} s", n, rounds, None, {"t_end": t_end})
+
+
+def part_ltca(n: int, rounds: int) -> dict[str, Any]:
+    """The LTCA kernel (its defaults) on the physical preset, as in benches/study_physical.py."""
+    return _part_kernel("ltca", "ltca physical", n, rounds, rvdyn.Scene.physical("rated"), {})
+
+
+def _part_kernel(kernel: str, label: str, n: int, rounds: int, scene: Any, options: dict[str, Any]) -> dict[str, Any]:
     res: dict[str, Any] = {}
     for workers in (1, 2):
         runners = _runners(workers)
@@ -95,12 +106,12 @@ def part_dynamic(n: int, rounds: int, t_end: float) -> dict[str, Any]:
         walls: dict[str, list[float]] = {name: [] for name in runners}
         for r in range(rounds):
             for name, (runner, _, _) in runners.items():
-                walls[name].append(_timed(runner, "dynamic", n, r, kernel_options={"t_end": t_end}))
+                walls[name].append(_timed(runner, kernel, n, r, scene, kernel_options=options))
         for name, (_, startup, close) in runners.items():
             close()
             med = statistics.median(walls[name])
             res[f"{name}/{workers}"] = {"samples_per_s": n / med, "wall_s": walls[name], "startup_s": startup}
-            print(f"dynamic t_end {t_end} s, {name:9s} {workers} worker(s): {n / med:6.2f} samples/s "
+            print(f"{label}, {name:9s} {workers} worker(s): {n / med:6.2f} samples/s "
                   f"(walls {', '.join(f'{w:.2f}' for w in walls[name])} s; start-up {startup:.2f} s)", flush=True)
     for name in ("threads", "processes", "dask"):
         if f"{name}/1" in res and f"{name}/2" in res:
@@ -182,7 +193,7 @@ def part_memory(sizes: list[int]) -> dict[str, Any]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--part", choices=("all", "dynamic", "overhead", "memory"), default="all")
+    ap.add_argument("--part", choices=("all", "dynamic", "ltca", "overhead", "memory"), default="all")
     ap.add_argument("--samples", type=int, default=12, help="dynamic samples per timing (default 12)")
     ap.add_argument("--rounds", type=int, default=2, help="interleaved rounds (default 2)")
     ap.add_argument("--t-end", type=float, default=0.5, help="dynamic run length [s] (default 0.5)")
@@ -192,6 +203,8 @@ def main() -> None:
     res: dict[str, Any] = {}
     if args.part in ("all", "dynamic"):
         res["dynamic"] = part_dynamic(args.samples, args.rounds, args.t_end)
+    if args.part in ("all", "ltca"):
+        res["ltca"] = part_ltca(8 * args.samples, args.rounds)
     if args.part in ("all", "overhead"):
         res["overhead"] = part_overhead(1000, args.rounds)
     if args.part in ("all", "memory"):
