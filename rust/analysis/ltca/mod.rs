@@ -609,28 +609,7 @@ impl Ltca {
             let laws = self.friction.clone();
             return self.twist_loop_with_friction(&laws, rated, psi, points);
         }
-        require_finite("rated torque", rated)?;
-        let rated = rated.abs();
-        if rated == 0.0 || points < 8 {
-            return Err(RvdynError::Parameter(format!(
-                "the torque-twist loop needs a rated torque > 0 N m and at least 8 points, got \
-                 {rated} N m and {points}"
-            )));
-        }
-        // Parameter s in [0, 4): 0 -> 1 -> -1 -> 0 piecewise linear.
-        let torque: Vec<f64> = (0..points)
-            .map(|i| {
-                let s = 4.0 * i as f64 / (points - 1) as f64;
-                let v = if s <= 1.0 {
-                    s
-                } else if s <= 3.0 {
-                    2.0 - s
-                } else {
-                    s - 4.0
-                };
-                rated * v
-            })
-            .collect();
+        let (torque, rated) = friction::loop_torques(rated, points)?;
         self.reset();
         let mut twist = Vec::with_capacity(points);
         let mut tangent = Vec::with_capacity(points);
