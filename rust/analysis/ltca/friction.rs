@@ -647,7 +647,7 @@ impl Ltca {
                 }
                 Err(e) => return Err(e),
             };
-            if let Some(l) = &self.last {
+            if let Some(l) = self.history.first() {
                 solved.push((ts, l.q.clone()));
             }
             tangent.push(self.last_tangent_stiffness());
@@ -663,11 +663,11 @@ impl Ltca {
                 .filter(|(s, _)| s.signum() == t.signum())
                 .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
             {
-                self.last = Some(super::Solved {
+                self.history = vec![super::Solved {
                     psi,
                     torque: *t0,
                     q: q0.clone(),
-                });
+                }];
             }
             let near = (t.abs() < 1e-6 * rated).then_some(rated);
             match self.friction_twist(laws, t, psi, d, near) {

@@ -745,3 +745,69 @@ fn report_equals_a_fresh_evaluation_at_the_solution() {
         assert!(ltca.statics.skipped > 100, "{}", ltca.statics.skipped);
     }
 }
+
+/// The warm start reproduces deflections that are polynomials of its degree along the history:
+/// quadratic in the torque at a fixed crank angle, linear in the crank angle at a fixed torque
+/// (exactly, to round-off of the deflections' size), and falls back to the last deflection
+/// beyond 1.5 spacings or across a change of both.
+#[test]
+fn warm_start_extrapolates_polynomials_of_its_degree() {
+    let st = Statics::new(&Scene::paper("rated").unwrap()).unwrap();
+    let n = st.dim();
+    let shape: Vec<f64> = (0..n).map(|a| 1e-6 * (1.0 + a as f64)).collect();
+    let point = |psi: f64, torque: f64, d: &dyn Fn(f64, f64) -> f64| Solved {
+        psi,
+        torque,
+        q: st
+            .kinematic_unknowns(psi)
+            .iter()
+            .zip(&shape)
+            .map(|(k, s)| k + s * d(psi, torque))
+            .collect(),
+    };
+    let close = |got: &[f64], psi: f64, torque: f64, d: &dyn Fn(f64, f64) -> f64, tol: f64| {
+        let want = point(psi, torque, d).q;
+        let worst = got
+            .iter()
+            .zip(&want)
+            .zip(&shape)
+            .map(|((g, w), s)| ((g - w) / s).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < tol, "predictor off by {worst:e} of the deflection");
+    };
+    // Quadratic in the torque (varying steps), crank angle fixed.
+    let quad = |_: f64, t: f64| 0.3 + 2e-4 * t - 3e-9 * t * t;
+    let h: Vec<Solved> = [3000.0, 2500.0, 1800.0]
+        .iter()
+        .map(|&t| point(0.7, t, &quad))
+        .collect();
+    let q = predictor(&h, &st, 0.7, 3600.0, st.kinematic_unknowns(0.7));
+    close(&q, 0.7, 3600.0, &quad, 1e-9);
+    // The same history with a linear deflection along the crank angle: linear is exact there,
+    // a quadratic one is not (so the degree is the one documented).
+    let lin = |p: f64, _: f64| 0.2 + 0.5 * p;
+    let curved = |p: f64, _: f64| 0.2 + 0.5 * p * p;
+    let h: Vec<Solved> = [0.72, 0.71, 0.70]
+        .iter()
+        .map(|&p| point(p, 5000.0, &lin))
+        .collect();
+    let q = predictor(&h, &st, 0.73, 5000.0, st.kinematic_unknowns(0.73));
+    close(&q, 0.73, 5000.0, &lin, 1e-9);
+    let h: Vec<Solved> = [0.72, 0.71, 0.70]
+        .iter()
+        .map(|&p| point(p, 5000.0, &curved))
+        .collect();
+    let q = predictor(&h, &st, 0.73, 5000.0, st.kinematic_unknowns(0.73));
+    let want = point(0.73, 5000.0, &curved).q;
+    let off = (q[0] - want[0]) / shape[0];
+    // Linear extrapolation through two points one step h ahead errs by h^2 f'' = 1e-4 for
+    // f = 0.5 p^2, h = 0.01 (below the truth).
+    assert!((off + 1e-4).abs() < 1e-9, "linear predictor error {off:e}");
+    // Two steps and a half ahead: no extrapolation, the last deflection.
+    let q = predictor(&h, &st, 0.745, 5000.0, st.kinematic_unknowns(0.745));
+    let last = 0.2 + 0.5 * 0.72 * 0.72;
+    close(&q, 0.745, 5000.0, &|_, _| last, 1e-9);
+    // Neither the torque nor the crank angle shared: the last deflection.
+    let q = predictor(&h, &st, 0.75, 100.0, st.kinematic_unknowns(0.75));
+    close(&q, 0.75, 100.0, &|_, _| last, 1e-9);
+}
