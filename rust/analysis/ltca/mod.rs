@@ -581,25 +581,39 @@ impl Ltca {
         let angles: Vec<f64> = (0..points)
             .map(|i| start + period * i as f64 / points as f64)
             .collect();
-        let mut run = |t: f64| -> Result<Vec<f64>> {
-            self.reset();
+        let run = |ltca: &mut Ltca, t: f64| -> Result<Vec<f64>> {
+            ltca.reset();
             angles
                 .iter()
                 .map(|&p| {
-                    let (out, _) = self.output_angle(t, p)?;
-                    let input = if self.statics.model.mesh.is_some() {
-                        self.statics.held_input(p)
+                    let (out, _) = ltca.output_angle(t, p)?;
+                    let input = if ltca.statics.model.mesh.is_some() {
+                        ltca.statics.held_input(p)
                     } else {
                         p
                     };
-                    Ok(out - input / self.ratio)
+                    Ok(out - input / ltca.ratio)
                 })
                 .collect()
         };
-        let forward = run(torque.abs())?;
-        let reverse = run(-torque.abs())?;
-        let unloaded_forward = run(light.abs())?;
-        let unloaded_reverse = run(-light.abs())?;
+        // The four sweeps are independent (each starts from the kinematic pose): two chains
+        // on two threads, each one loaded and one light sweep (the light ones cost several
+        // times more), this analysis ending as after the light reverse sweep.
+        let mut other = self.clone();
+        let evaluations = self.statics.evaluations;
+        let (a, b) = rayon::join(
+            || -> Result<(Vec<f64>, Vec<f64>)> {
+                Ok((
+                    run(&mut other, torque.abs())?,
+                    run(&mut other, light.abs())?,
+                ))
+            },
+            || -> Result<(Vec<f64>, Vec<f64>)> {
+                Ok((run(self, -torque.abs())?, run(self, -light.abs())?))
+            },
+        );
+        self.statics.evaluations += other.statics.evaluations - evaluations;
+        let ((forward, unloaded_forward), (reverse, unloaded_reverse)) = (a?, b?);
         Ok(TransmissionError {
             crank_angle: angles,
             period,
