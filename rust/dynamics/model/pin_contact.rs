@@ -292,7 +292,7 @@ impl SeparationBound {
 /// given), the exact query, the bound update and the penetration check (when `max_penetration`
 /// is given). `Ok(None)` when the pin does not touch.
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 pub(crate) fn touching_pin(
     disc: &DiscModel,
     pin: &PinModel,
