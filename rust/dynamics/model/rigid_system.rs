@@ -202,10 +202,15 @@ impl ReducerModel for RigidSystem<'_> {
     ) -> Result<Observation> {
         let m = self.model;
         let (x, xv, acc) = self.full(t, q, v);
-        // Keep each planet's mesh force for the crank reactions.
+        // Keep each planet's mesh force for the crank reactions (when they are wanted).
+        let bearings = sink.wants_bearings();
         let sink = &mut MeshCapture {
             inner: sink,
-            force: vec![0.0; m.cranks],
+            force: if bearings {
+                vec![0.0; m.cranks]
+            } else {
+                Vec::new()
+            },
         };
         let (f, qa, sh) = if sink.wants_forces() {
             if m.output_shaft.is_none() && m.input_shaft.is_none() {
@@ -236,7 +241,7 @@ impl ReducerModel for RigidSystem<'_> {
             (None, Some(tq)) => tq,
             (None, None) => 0.0,
         };
-        if sink.wants_forces() {
+        if sink.wants_forces() && bearings {
             // Accelerations of the full coordinates: Q / M of the free ones, the drive's of the
             // prescribed one.
             let mut xa = [0.0; FULL];
@@ -322,6 +327,9 @@ impl ContactSink for MeshCapture<'_> {
     }
     fn checks_bounds(&self) -> bool {
         self.inner.checks_bounds()
+    }
+    fn wants_bearings(&self) -> bool {
+        self.inner.wants_bearings()
     }
     fn pin(
         &mut self,
