@@ -279,7 +279,7 @@ impl CycloidGeometry {
         require_positive("pin_radius", pin_radius, "m")?;
         let seed = self
             .seed
-            .seed(p)
+            .seed(self, p)
             .ok_or_else(|| RvdynError::Parameter("pin and disc positions must be finite".into()))?;
         let foot = self.foot(p, seed).ok_or_else(|| self.no_foot(p))?;
         Ok(self.to_global(&foot, pin_radius, disc_center, sc))
@@ -327,7 +327,7 @@ impl CycloidGeometry {
             let (s, c) = small_sin_cos(turn_by);
             self.foot_with_fallback_cs(p, warm.phi + turn_by, cmul(warm.cos_sin, [c, s]))
         } else {
-            self.seed.seed(p).and_then(|seed| self.foot(p, seed))
+            self.seed.seed(self, p).and_then(|seed| self.foot(p, seed))
         }
         .ok_or_else(|| self.no_foot(p))?;
         let drift = foot.phi - (warm.phi + rot);
@@ -357,7 +357,7 @@ impl CycloidGeometry {
     ) -> Option<LocalFoot> {
         match self.foot_cs(p, seed, cs) {
             Some(f) => Some(f),
-            None => self.foot(p, self.seed.seed(p)?),
+            None => self.foot(p, self.seed.seed(self, p)?),
         }
     }
 
@@ -883,7 +883,7 @@ mod shift_tests {
                     j.c[1] + out * n[1] + along * t[1],
                 ];
                 let (_, dmin) = brute_min_distance(&g, p);
-                for seed in [root, root + 0.02, root - 0.05, g.seed.seed(p).unwrap()] {
+                for seed in [root, root + 0.02, root - 0.05, g.seed.seed(&g, p).unwrap()] {
                     let f = g.foot(p, seed).unwrap();
                     let sign = if f.dist < 0.0 { -1.0 } else { 1.0 };
                     worst = worst.max((f.dist - sign * dmin).abs());

@@ -12,7 +12,7 @@
 //! `Q = -F grad(delta)`. Prescribed coordinates are taken from the drive; the reaction
 //! `M_ii a_i - Q_i` on them is the input torque.
 
-use crate::contact::law::PinSite;
+use crate::contact::law::{PinLaw, PinSite};
 use crate::dynamics::model::parts::MeshOffset;
 pub(crate) use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::pin_contact::{
@@ -304,14 +304,17 @@ impl RigidModel {
                     out.friction[0] += p;
                 }
                 // Location term of a line law (its energy depends on the contact's place on
-                // the profile): dO/dalpha = z x O, dtheta/dth_c = 1.
-                if let Some(ls) = self.pin_law.location_slope_at(
-                    lf.elastic,
-                    &site,
-                    pin.centre,
-                    o,
-                    (pose.sin, pose.cos),
-                ) {
+                // the profile): dO/dalpha = z x O, dtheta/dth_c = 1. (Tested for the law here,
+                // not in the call: the IMPACT law's evaluations then skip the call.)
+                if matches!(self.pin_law, PinLaw::Line { .. })
+                    && let Some(ls) = self.pin_law.location_slope_at(
+                        lf.elastic,
+                        &site,
+                        pin.centre,
+                        o,
+                        (pose.sin, pose.cos),
+                    )
+                {
                     let (fo, m) = ls.forces();
                     out.q[CARRIER] += m;
                     out.q[CRANK] += fo[1] * o[0] - fo[0] * o[1];
