@@ -118,8 +118,7 @@ impl ProfileSeed {
                     Vector::new(p[0], p[1])
                 })
                 .collect();
-            let indices: Vec<[u32; 2]> =
-                (0..n as u32).map(|i| [i, (i + 1) % n as u32]).collect();
+            let indices: Vec<[u32; 2]> = (0..n as u32).map(|i| [i, (i + 1) % n as u32]).collect();
             Polyline::new(vertices, Some(indices))
         }))
     }

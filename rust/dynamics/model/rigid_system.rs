@@ -4,7 +4,7 @@ use crate::dynamics::model::parts::ShaftLoads;
 use crate::dynamics::model::pin_contact::{first_touch_report, mark_open};
 use crate::dynamics::model::rigid::{CARRIER, CRANK, FULL, Forces, LOAD, MOTOR, RigidModel, SUN};
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
-use crate::dynamics::run::sink::{ContactSink, DynSink, NoSink};
+use crate::dynamics::run::sink::{ContactSink, NoSink};
 use crate::error::Result;
 use crate::solve::MechanicalSystem;
 
@@ -215,16 +215,11 @@ impl ReducerModel for RigidSystem<'_> {
         let (f, qa, sh) = if sink.wants_forces() {
             if m.output_shaft.is_none() && m.input_shaft.is_none() {
                 // No shafts: the reducer's forces alone, called directly (as in `eval`).
-                let f = m.forces(
-                    t,
-                    &[x[0], x[1], x[2]],
-                    &[xv[0], xv[1], xv[2]],
-                    &mut DynSink(sink),
-                )?;
+                let f = m.forces(t, &[x[0], x[1], x[2]], &[xv[0], xv[1], xv[2]], sink)?;
                 let qa = [f.q[0], f.q[1], f.q[2], 0.0, 0.0];
                 (f, qa, ShaftLoads::default())
             } else {
-                self.all_forces(t, &x, &xv, &mut DynSink(sink))?
+                self.all_forces(t, &x, &xv, sink)?
             }
         } else {
             let sh = m.shaft_loads(
@@ -312,7 +307,9 @@ impl ReducerModel for RigidSystem<'_> {
     }
 }
 
-/// A sink that passes everything on and keeps each mesh's force (for the crank reactions).
+/// A sink that passes everything on and keeps each mesh's force (for the crank reactions);
+/// the force routine is instantiated for it, so that a contact reaches the recorder's sink
+/// through one dynamic call.
 struct MeshCapture<'a> {
     inner: &'a mut dyn ContactSink,
     force: Vec<f64>,

@@ -351,11 +351,13 @@ pub fn run_with<M: ReducerModel>(
         record(&mut rec, &st)?;
         next_sample += 1;
     }
+    // The state at the start of the step, kept in place (its vectors are reused).
+    let mut prev = st.clone();
     while st.t < opt.t_end * (1.0 - 1e-14) {
         if control.stopped() {
             return Err(RvdynError::Interrupted);
         }
-        let prev = st.clone();
+        copy_state(&mut prev, &st);
         integrator.advance(sys, &mut st, opt.t_end)?;
         if !st.q.iter().chain(&st.v).all(|v| v.is_finite()) {
             return Err(RvdynError::Simulation(format!(
@@ -413,6 +415,25 @@ pub fn run_with<M: ReducerModel>(
     }
     out.final_state = Some((st.t, st.q, st.v));
     Ok(out)
+}
+
+/// `*dst = src.clone()` without new allocations (every field named: a new one fails to compile
+/// here until it is copied).
+fn copy_state(dst: &mut State, src: &State) {
+    let State {
+        t,
+        q,
+        v,
+        a,
+        power,
+        work,
+    } = src;
+    dst.t = *t;
+    dst.q.clone_from(q);
+    dst.v.clone_from(v);
+    dst.a.clone_from(a);
+    dst.power = *power;
+    dst.work = *work;
 }
 
 #[cfg(test)]
