@@ -400,8 +400,13 @@ pub fn run_with<M: ReducerModel>(
             if ts > st.t + 1e-12 {
                 break;
             }
-            let s = prev.interpolate(&st, ts);
-            record(&mut rec, &s)?;
+            if at_step_end(&prev, &st, ts) {
+                // What the interpolation gives there (its weights are 0 and 1), without a copy.
+                rec.sample(sys, ts, &st.q, &st.v, st.work)?;
+            } else {
+                let s = prev.interpolate(&st, ts);
+                record(&mut rec, &s)?;
+            }
             next_sample += 1;
         }
         control.set_time(st.t);
@@ -415,6 +420,17 @@ pub fn run_with<M: ReducerModel>(
     }
     out.final_state = Some((st.t, st.q, st.v));
     Ok(out)
+}
+
+/// Whether [`State::interpolate`] from `prev` to `next` at `t` is at `next` (its parameter
+/// clamped to 1), where it gives `next`'s coordinates, velocities and work.
+fn at_step_end(prev: &State, next: &State, t: f64) -> bool {
+    let h = next.t - prev.t;
+    if h > 0.0 {
+        (t - prev.t) / h >= 1.0
+    } else {
+        true
+    }
 }
 
 /// `*dst = src.clone()` without new allocations (every field named: a new one fails to compile
