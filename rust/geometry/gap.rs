@@ -361,6 +361,17 @@ impl CycloidGeometry {
         }
     }
 
+    /// As [`CycloidGeometry::foot_with_fallback_cs`] for a caller that uses neither `d1` nor
+    /// `d2` of the foot (the models' pin queries): `d2` is not moved to the foot and is NaN.
+    /// Everything else is the same, bit for bit.
+    #[inline]
+    pub(crate) fn contact_foot(&self, p: [f64; 2], seed: f64, cs: [f64; 2]) -> Option<LocalFoot> {
+        match self.foot_iterate::<false>(p, seed, cs) {
+            Some(f) => Some(f),
+            None => self.foot(p, self.seed.seed(self, p)?),
+        }
+    }
+
     /// The nearest point of the pin-centre curve to `p` from `seed`. Unrotated disc frame.
     #[inline]
     pub(crate) fn foot(&self, p: [f64; 2], seed: f64) -> Option<LocalFoot> {
@@ -387,6 +398,17 @@ impl CycloidGeometry {
     /// the nearer foot. `None` if no foot is found.
     #[inline]
     pub(crate) fn foot_cs(&self, p: [f64; 2], seed: f64, seed_cs: [f64; 2]) -> Option<LocalFoot> {
+        self.foot_iterate::<true>(p, seed, seed_cs)
+    }
+
+    /// [`CycloidGeometry::foot_cs`]; without `D2` the foot's `d2` is NaN (not moved to it).
+    #[inline]
+    fn foot_iterate<const D2: bool>(
+        &self,
+        p: [f64; 2],
+        seed: f64,
+        seed_cs: [f64; 2],
+    ) -> Option<LocalFoot> {
         let k = &self.seed.curve;
         let zp = f64::from(k.zp);
         let max_step = PI / (2.0 * zp);
@@ -422,7 +444,11 @@ impl CycloidGeometry {
                 let moved = Derivs {
                     c: taylor(d.c, d.d1, d.d2, d.d3),
                     d1: taylor(d.d1, d.d2, d.d3, d.d4),
-                    d2: taylor(d.d2, d.d3, d.d4, [0.0; 2]),
+                    d2: if D2 {
+                        taylor(d.d2, d.d3, d.d4, [0.0; 2])
+                    } else {
+                        [f64::NAN; 2]
+                    },
                     d3: d.d3,
                     d4: d.d4,
                 };

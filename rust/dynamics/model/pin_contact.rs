@@ -188,7 +188,7 @@ pub(crate) fn pin_query(
         let (s, c) = kinematic.sin_cos();
         (kinematic, [c, s])
     };
-    let foot = g.foot_with_fallback_cs(local, seed, cs).ok_or_else(|| {
+    let foot = g.contact_foot(local, seed, cs).ok_or_else(|| {
         // In a run this means the state is unphysical, so it is a simulation failure.
         RvdynError::Simulation(format!(
             "exact gap of pin {} on disc {} not found at t = {t:.6e} s: the disc is farther \
