@@ -161,7 +161,7 @@ impl PinContact {
 /// kinematic parameter; the parry polyline is the fallback seed. The answer does not depend on
 /// the seed (Newton converges to 1e-13 m on the exact curve): the warm start only saves
 /// iterations. `warm` is updated.
-#[inline]
+#[inline(always)]
 pub(crate) fn pin_query(
     disc: &DiscModel,
     pin: &PinModel,
