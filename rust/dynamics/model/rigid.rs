@@ -13,7 +13,7 @@
 //! `M_ii a_i - Q_i` on them is the input torque.
 
 use crate::contact::law::{PinLaw, PinSite};
-use crate::dynamics::model::parts::MeshOffset;
+use crate::dynamics::model::parts::{DiscModel, MeshOffset};
 pub(crate) use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::pin_contact::{
     DiscPose, SeparationBound, WarmStart, penetration_error, pin_law_force, touching_pin,
@@ -206,15 +206,43 @@ impl RigidModel {
         }
     }
 
-    /// Disc `k` centre [m] and angle [rad] for the full coordinates `x`.
-    #[inline]
+    /// Disc `k` centre [m] and angle [rad] for the full coordinates `x` (as the force
+    /// evaluation places it; for tests).
+    #[cfg(test)]
     pub(crate) fn disc_pose(&self, k: usize, x: &[f64; 3]) -> ([f64; 2], f64) {
         let d = &self.discs[k];
-        let (s, c) = (x[CRANK] + d.phase).sin_cos();
         (
-            [self.eccentricity * c, self.eccentricity * s],
+            self.disc_centre(d, x[CRANK].sin_cos()),
             x[CARRIER] + d.angle_offset,
         )
+    }
+
+    /// The centre [m] of disc `d` from the sine and cosine of the crank angle, turned by the
+    /// disc's phase (one `sin_cos` per evaluation instead of one per disc).
+    #[inline]
+    pub(crate) fn disc_centre(&self, d: &DiscModel, (sa, ca): (f64, f64)) -> [f64; 2] {
+        let [cp, sp] = d.phase_cs;
+        let e = self.eccentricity;
+        [e * (ca * cp - sa * sp), e * (sa * cp + ca * sp)]
+    }
+
+    /// The pose of disc `d` for the full coordinates `x`, from the sine and cosine of the crank
+    /// and of the carrier angle (the disc's are those turned by its phase and angle offset).
+    #[inline]
+    fn disc_pose_sc(
+        &self,
+        d: &DiscModel,
+        x: &[f64; 3],
+        crank: (f64, f64),
+        (st, ct): (f64, f64),
+    ) -> DiscPose {
+        let [co, so] = d.offset_cs;
+        DiscPose {
+            centre: self.disc_centre(d, crank),
+            angle: x[CARRIER] + d.angle_offset,
+            sin: st * co + ct * so,
+            cos: ct * co - st * so,
+        }
     }
 
     /// Generalised forces at `(t, x, v)` (full coordinates), reporting every contact to `sink`.
@@ -233,9 +261,10 @@ impl RigidModel {
         let check = sink.checks_bounds();
         let vc = v[CARRIER];
         let va = v[CRANK];
+        let (crank, carrier) = (x[CRANK].sin_cos(), x[CARRIER].sin_cos());
         for (k, d) in self.discs.iter().enumerate() {
-            let (o, th) = self.disc_pose(k, x);
-            let pose = DiscPose::new(o, th);
+            let pose = self.disc_pose_sc(d, x, crank, carrier);
+            let o = pose.centre;
             for (j, pin) in self.pins.iter().enumerate() {
                 let idx = k * self.pins.len() + j;
                 let sep = self

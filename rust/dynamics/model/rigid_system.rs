@@ -259,8 +259,11 @@ impl ReducerModel for RigidSystem<'_> {
                 sink.bearing(0, i, *r);
             }
         }
-        let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = (0..m.discs.len())
-            .map(|k| m.disc_pose(k, &[x[0], x[1], x[2]]))
+        let crank = x[CRANK].sin_cos();
+        let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = m
+            .discs
+            .iter()
+            .map(|d| (m.disc_centre(d, crank), x[CARRIER] + d.angle_offset))
             .unzip();
         Ok(Observation {
             sun_angle: x[SUN],
