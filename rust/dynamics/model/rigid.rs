@@ -13,8 +13,8 @@
 //! `M_ii a_i - Q_i` on them is the input torque.
 
 use crate::contact::law::{PinLaw, PinSite};
-use crate::dynamics::model::parts::{DiscModel, MeshOffset};
 pub(crate) use crate::dynamics::model::parts::Parts;
+use crate::dynamics::model::parts::{DiscModel, MeshOffset};
 use crate::dynamics::model::pin_contact::{
     DiscPose, SeparationBound, WarmStart, penetration_error, pin_law_force, touching_pin,
 };
