@@ -29,38 +29,6 @@ impl DiscPose {
     }
 }
 
-/// `sin x` and `cos x` from the last angle evaluated by `sin_cos` (the anchor), turned by the
-/// difference when it is below 1e-3 rad (Taylor series, exact to round-off), else by `sin_cos`
-/// (which becomes the anchor). An integrator's evaluations within a step (Newton's later
-/// iterates, the Jacobian's, the sample at its end) are that close to each other: they share
-/// the anchor of the step's first evaluation. The anchor never moves by a Taylor turn, so the
-/// results carry no drift, only the 1-2 ulp of one turn.
-#[derive(Debug, Clone)]
-pub(crate) struct SinCosCache(Cell<(f64, f64, f64)>);
-
-impl Default for SinCosCache {
-    fn default() -> Self {
-        Self(Cell::new((f64::NAN, f64::NAN, f64::NAN)))
-    }
-}
-
-impl SinCosCache {
-    /// `(sin x, cos x)`.
-    #[inline]
-    pub(crate) fn sin_cos(&self, x: f64) -> (f64, f64) {
-        let (xa, sa, ca) = self.0.get();
-        let d = x - xa;
-        if d.abs() < 1e-3 {
-            let (ds, dc) = small_sin_cos(d);
-            (sa * dc + ca * ds, ca * dc - sa * ds)
-        } else {
-            let (s, c) = x.sin_cos();
-            self.0.set((x, s, c));
-            (s, c)
-        }
-    }
-}
-
 /// The foot parameter of a (disc, pin) contact at the previous evaluation, with its cosine and
 /// sine: the Newton warm start of the next one.
 #[derive(Debug, Clone, Copy)]
@@ -388,35 +356,6 @@ pub(crate) fn pin_law_force(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The anchored `sin_cos` against `f64::sin_cos` along a walk of angles up to 400 rad (the
-    /// carrier's after 5 s) with steps from 1e-9 to 0.3 rad, 200 000 of them below the 1e-3 rad
-    /// that keeps the anchor: within 4 ulp of 1 (the difference `x - anchor` is exact, the
-    /// Taylor turn adds 1-2 ulp to the anchor's; measured 1 ulp) and no drift over the walk
-    /// (the anchor is never turned).
-    #[test]
-    fn anchored_sin_cos_is_sin_cos() {
-        let cache = SinCosCache::default();
-        let mut x = -400.0_f64;
-        let mut worst: f64 = 0.0;
-        let mut seed = 12345_u64;
-        for i in 0..300_000 {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let u = (seed >> 11) as f64 / (1u64 << 53) as f64;
-            let step = if i % 3 == 0 {
-                0.3 * u
-            } else {
-                1e-9 + 9e-4 * u * u
-            };
-            x += if x > 400.0 { -step } else { step };
-            let (s, c) = cache.sin_cos(x);
-            let (se, ce) = x.sin_cos();
-            worst = worst.max((s - se).abs()).max((c - ce).abs());
-        }
-        assert!(worst <= 4.0 * f64::EPSILON, "largest difference {worst:e}");
-    }
     use crate::contact::hertz::Material;
     use crate::contact::law::{ContactDamping, DampingSpec};
     use crate::geometry::CycloidGeometry;

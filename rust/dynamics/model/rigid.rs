@@ -16,8 +16,7 @@ use crate::contact::law::{PinLaw, PinSite};
 pub(crate) use crate::dynamics::model::parts::Parts;
 use crate::dynamics::model::parts::{DiscModel, MeshOffset};
 use crate::dynamics::model::pin_contact::{
-    DiscPose, SeparationBound, SinCosCache, WarmStart, penetration_error, pin_law_force,
-    touching_pin,
+    DiscPose, SeparationBound, WarmStart, penetration_error, pin_law_force, touching_pin,
 };
 use crate::dynamics::run::sink::ContactSink;
 use crate::dynamics::scene::{Initial, Joints, Scene};
@@ -78,8 +77,6 @@ pub struct RigidModel {
     /// Skip the exact query of a pin that provably cannot touch (see [`SeparationBound`]).
     pub(crate) skip_separated: bool,
     separation: Vec<Cell<SeparationBound>>,
-    /// `sin_cos` of the crank and of the carrier angle, anchored (see [`SinCosCache`]).
-    trig: [SinCosCache; 2],
 }
 
 impl std::ops::Deref for RigidModel {
@@ -169,7 +166,6 @@ impl RigidModel {
             // is not one: query every pin.
             skip_separated: skip,
             separation: vec![Cell::new(SeparationBound::default()); scene.discs.len() * zp],
-            trig: Default::default(),
         })
     }
 
@@ -221,12 +217,6 @@ impl RigidModel {
         )
     }
 
-    /// `sin_cos` of the crank angle `a` [rad] (anchored: see [`SinCosCache`]).
-    #[inline]
-    pub(crate) fn crank_sin_cos(&self, a: f64) -> (f64, f64) {
-        self.trig[0].sin_cos(a)
-    }
-
     /// The centre [m] of disc `d` from the sine and cosine of the crank angle, turned by the
     /// disc's phase (one `sin_cos` per evaluation instead of one per disc).
     #[inline]
@@ -271,10 +261,7 @@ impl RigidModel {
         let check = sink.checks_bounds();
         let vc = v[CARRIER];
         let va = v[CRANK];
-        let (crank, carrier) = (
-            self.crank_sin_cos(x[CRANK]),
-            self.trig[1].sin_cos(x[CARRIER]),
-        );
+        let (crank, carrier) = (x[CRANK].sin_cos(), x[CARRIER].sin_cos());
         for (k, d) in self.discs.iter().enumerate() {
             let pose = self.disc_pose_sc(d, x, crank, carrier);
             let o = pose.centre;

@@ -259,7 +259,7 @@ impl ReducerModel for RigidSystem<'_> {
                 sink.bearing(0, i, *r);
             }
         }
-        let crank = m.crank_sin_cos(x[CRANK]);
+        let crank = x[CRANK].sin_cos();
         let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = m
             .discs
             .iter()
