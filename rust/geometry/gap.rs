@@ -421,12 +421,16 @@ impl CycloidGeometry {
             if h2.is_nan() || h2 <= 0.0 {
                 return self.foot_near_root(p);
             }
+            // Halley's step -h1 / (h2 (1 + n q)), n = -h1 / h2 the Newton step and
+            // q = h3 / (2 h2), written with one division: -h1 h2 / (h2^2 - h1 h3 / 2); it is
+            // taken while 1 + n q > 1/2. (The division of q and of the error estimate is off
+            // the iteration's chain of dependent operations.)
+            let h2sq = h2 * h2;
+            let den = h2sq - 0.5 * h1 * h3;
+            let halley = den > 0.5 * h2sq;
+            let step = if halley { -h1 * h2 / den } else { -h1 / h2 }.clamp(-max_step, max_step);
             let inv = 1.0 / h2;
-            let newton = -h1 * inv;
             let q = 0.5 * h3 * inv;
-            let corr = 1.0 + newton * q;
-            let halley = corr > 0.5;
-            let step = if halley { newton / corr } else { newton }.clamp(-max_step, max_step);
             let err = (q * q + (h4 * inv).abs() / 6.0) * (step * step * step).abs();
             phi += step;
             u = turn(u, step, || {
