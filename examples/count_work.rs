@@ -89,6 +89,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let r = simulate(&scene, &opt, &RunControl::default())?;
     println!("{} samples, stats {:?}", r.samples, r.stats);
+    // A digest of the results, to check that a change of the code leaves them as they were.
+    if let Some(f) = r.series.get("pin_force") {
+        let sum: f64 = f.data.iter().sum();
+        let peak = f.data.iter().fold(0.0_f64, |m, x| m.max(*x));
+        println!("pin_force: sum {sum:.17e}, peak {peak:.17e}");
+    }
+    if let Some((t, q, v)) = &r.final_state {
+        println!("final state at t = {t}: q = {q:?}, v = {v:?}");
+    }
     Ok(())
 }
 

@@ -279,7 +279,7 @@ impl CycloidGeometry {
         require_positive("pin_radius", pin_radius, "m")?;
         let seed = self
             .seed
-            .seed(p)
+            .seed(self, p)
             .ok_or_else(|| RvdynError::Parameter("pin and disc positions must be finite".into()))?;
         let foot = self.foot(p, seed).ok_or_else(|| self.no_foot(p))?;
         Ok(self.to_global(&foot, pin_radius, disc_center, sc))
@@ -327,7 +327,7 @@ impl CycloidGeometry {
             let (s, c) = small_sin_cos(turn_by);
             self.foot_with_fallback_cs(p, warm.phi + turn_by, cmul(warm.cos_sin, [c, s]))
         } else {
-            self.seed.seed(p).and_then(|seed| self.foot(p, seed))
+            self.seed.seed(self, p).and_then(|seed| self.foot(p, seed))
         }
         .ok_or_else(|| self.no_foot(p))?;
         let drift = foot.phi - (warm.phi + rot);
@@ -357,7 +357,18 @@ impl CycloidGeometry {
     ) -> Option<LocalFoot> {
         match self.foot_cs(p, seed, cs) {
             Some(f) => Some(f),
-            None => self.foot(p, self.seed.seed(p)?),
+            None => self.foot(p, self.seed.seed(self, p)?),
+        }
+    }
+
+    /// As [`CycloidGeometry::foot_with_fallback_cs`] for a caller that uses neither `d1` nor
+    /// `d2` of the foot (the models' pin queries): `d2` is not moved to the foot and is NaN.
+    /// Everything else is the same, bit for bit.
+    #[inline]
+    pub(crate) fn contact_foot(&self, p: [f64; 2], seed: f64, cs: [f64; 2]) -> Option<LocalFoot> {
+        match self.foot_iterate::<false>(p, seed, cs) {
+            Some(f) => Some(f),
+            None => self.foot(p, self.seed.seed(self, p)?),
         }
     }
 
@@ -387,6 +398,17 @@ impl CycloidGeometry {
     /// the nearer foot. `None` if no foot is found.
     #[inline]
     pub(crate) fn foot_cs(&self, p: [f64; 2], seed: f64, seed_cs: [f64; 2]) -> Option<LocalFoot> {
+        self.foot_iterate::<true>(p, seed, seed_cs)
+    }
+
+    /// [`CycloidGeometry::foot_cs`]; without `D2` the foot's `d2` is NaN (not moved to it).
+    #[inline]
+    fn foot_iterate<const D2: bool>(
+        &self,
+        p: [f64; 2],
+        seed: f64,
+        seed_cs: [f64; 2],
+    ) -> Option<LocalFoot> {
         let k = &self.seed.curve;
         let zp = f64::from(k.zp);
         let max_step = PI / (2.0 * zp);
@@ -399,12 +421,16 @@ impl CycloidGeometry {
             if h2.is_nan() || h2 <= 0.0 {
                 return self.foot_near_root(p);
             }
+            // Halley's step -h1 / (h2 (1 + n q)), n = -h1 / h2 the Newton step and
+            // q = h3 / (2 h2), written with one division: -h1 h2 / (h2^2 - h1 h3 / 2); it is
+            // taken while 1 + n q > 1/2. (The division of q and of the error estimate is off
+            // the iteration's chain of dependent operations.)
+            let h2sq = h2 * h2;
+            let den = h2sq - 0.5 * h1 * h3;
+            let halley = den > 0.5 * h2sq;
+            let step = if halley { -h1 * h2 / den } else { -h1 / h2 }.clamp(-max_step, max_step);
             let inv = 1.0 / h2;
-            let newton = -h1 * inv;
             let q = 0.5 * h3 * inv;
-            let corr = 1.0 + newton * q;
-            let halley = corr > 0.5;
-            let step = if halley { newton / corr } else { newton }.clamp(-max_step, max_step);
             let err = (q * q + (h4 * inv).abs() / 6.0) * (step * step * step).abs();
             phi += step;
             u = turn(u, step, || {
@@ -422,7 +448,11 @@ impl CycloidGeometry {
                 let moved = Derivs {
                     c: taylor(d.c, d.d1, d.d2, d.d3),
                     d1: taylor(d.d1, d.d2, d.d3, d.d4),
-                    d2: taylor(d.d2, d.d3, d.d4, [0.0; 2]),
+                    d2: if D2 {
+                        taylor(d.d2, d.d3, d.d4, [0.0; 2])
+                    } else {
+                        [f64::NAN; 2]
+                    },
                     d3: d.d3,
                     d4: d.d4,
                 };
@@ -883,7 +913,7 @@ mod shift_tests {
                     j.c[1] + out * n[1] + along * t[1],
                 ];
                 let (_, dmin) = brute_min_distance(&g, p);
-                for seed in [root, root + 0.02, root - 0.05, g.seed.seed(p).unwrap()] {
+                for seed in [root, root + 0.02, root - 0.05, g.seed.seed(&g, p).unwrap()] {
                     let f = g.foot(p, seed).unwrap();
                     let sign = if f.dist < 0.0 { -1.0 } else { 1.0 };
                     worst = worst.max((f.dist - sign * dmin).abs());

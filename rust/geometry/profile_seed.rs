@@ -2,20 +2,23 @@
 //!
 //! The polyline is never the answer (its chord error is micrometres); it only tells which
 //! stretch of the curve is nearest to a pin, so that Newton on the exact curve parameter starts
-//! in the right basin, including on the concave root where local minima exist.
+//! in the right basin, including on the concave root where local minima exist. It is built at
+//! the first query that needs it: a run whose warm-started queries never fail never builds it.
 
 use crate::geometry::cycloid::CycloidGeometry;
 use parry2d_f64::math::Vector;
 use parry2d_f64::query::PointQueryWithLocation;
 use parry2d_f64::shape::{Polyline, SegmentPointLocation};
 use std::f64::consts::PI;
+use std::sync::OnceLock;
 
 /// A closed, counter-clockwise polyline of the unrotated profile and the curve parameter of
-/// each vertex (uniform in `phi`).
+/// each vertex (uniform in `phi`), built when first queried.
 #[derive(Clone)]
 pub struct ProfileSeed {
-    polyline: Option<Polyline>,
-    dphi: f64,
+    /// Vertices per lobe (0: no polyline, a geometry being built).
+    per_lobe: usize,
+    polyline: OnceLock<Polyline>,
     pub(crate) curve: CurveConsts,
 }
 
@@ -80,49 +83,65 @@ impl CurveConsts {
 impl ProfileSeed {
     pub(crate) fn empty() -> Self {
         Self {
-            polyline: None,
-            dphi: 0.0,
+            per_lobe: 0,
+            polyline: OnceLock::new(),
             curve: CurveConsts::unset(),
         }
     }
 
-    /// Sample the profile with `per_lobe` vertices per lobe.
+    /// The seed of `geometry` with `per_lobe` vertices per lobe (at least 8), sampled at the
+    /// first query.
     pub(crate) fn build(geometry: &CycloidGeometry, per_lobe: usize) -> Self {
-        let n = per_lobe.max(8) * geometry.lobes() as usize;
-        let dphi = 2.0 * PI / n as f64;
-        let vertices: Vec<Vector> = (0..n)
-            .map(|i| {
-                let p = geometry.unrotated_profile_point(i as f64 * dphi);
-                Vector::new(p[0], p[1])
-            })
-            .collect();
-        let indices: Vec<[u32; 2]> = (0..n as u32).map(|i| [i, (i + 1) % n as u32]).collect();
         Self {
-            polyline: Some(Polyline::new(vertices, Some(indices))),
-            dphi,
+            per_lobe: per_lobe.max(8),
+            polyline: OnceLock::new(),
             curve: CurveConsts::of(geometry),
         }
     }
 
-    /// Curve parameter of the polyline point nearest to `point` (unrotated disc frame), or
-    /// `None` if the point is not finite.
-    pub(crate) fn seed(&self, point: [f64; 2]) -> Option<f64> {
-        let poly = self.polyline.as_ref()?;
+    /// Parameter step between vertices [rad] of `geometry`'s polyline.
+    fn dphi(&self, geometry: &CycloidGeometry) -> f64 {
+        2.0 * PI / (self.per_lobe * geometry.lobes() as usize) as f64
+    }
+
+    /// The polyline of `geometry` (whose seed this is), sampled now if it was not yet.
+    fn polyline(&self, geometry: &CycloidGeometry) -> Option<&Polyline> {
+        if self.per_lobe == 0 {
+            return None;
+        }
+        Some(self.polyline.get_or_init(|| {
+            let n = self.per_lobe * geometry.lobes() as usize;
+            let dphi = self.dphi(geometry);
+            let vertices: Vec<Vector> = (0..n)
+                .map(|i| {
+                    let p = geometry.unrotated_profile_point(i as f64 * dphi);
+                    Vector::new(p[0], p[1])
+                })
+                .collect();
+            let indices: Vec<[u32; 2]> = (0..n as u32).map(|i| [i, (i + 1) % n as u32]).collect();
+            Polyline::new(vertices, Some(indices))
+        }))
+    }
+
+    /// Curve parameter of the polyline point nearest to `point` (unrotated disc frame) of
+    /// `geometry` (whose seed this is), or `None` if the point is not finite.
+    pub(crate) fn seed(&self, geometry: &CycloidGeometry, point: [f64; 2]) -> Option<f64> {
         if !(point[0].is_finite() && point[1].is_finite()) {
             return None;
         }
+        let poly = self.polyline(geometry)?;
         let (_, (seg, loc)) =
             poly.project_local_point_and_get_location(Vector::new(point[0], point[1]), false);
         let t = match loc {
             SegmentPointLocation::OnVertex(i) => f64::from(i),
             SegmentPointLocation::OnEdge([_, v]) => v,
         };
-        Some((f64::from(seg) + t) * self.dphi)
+        Some((f64::from(seg) + t) * self.dphi(geometry))
     }
 
-    /// Number of polyline vertices.
+    /// Number of polyline vertices (sampled or not yet).
     pub fn len(&self) -> usize {
-        self.polyline.as_ref().map_or(0, |p| p.vertices().len())
+        self.per_lobe * self.curve.zp.saturating_sub(1) as usize
     }
 
     /// True if the seed has no polyline (only while a geometry is being built).

@@ -71,6 +71,19 @@ pub struct Attempt {
     pub theta: f64,
 }
 
+/// The vectors of one Newton iteration: the start's pseudo-acceleration, the end's
+/// acceleration, pseudo-acceleration, coordinates and velocities (which become the attempt),
+/// and the scratch of the evaluation and the residual.
+struct Vectors<'a> {
+    p0: Vec<f64>,
+    a1: Vec<f64>,
+    p1: Vec<f64>,
+    q1: Vec<f64>,
+    v1: Vec<f64>,
+    f: &'a mut Vec<f64>,
+    r: &'a mut DVector<f64>,
+}
+
 /// Generalized-alpha stepper with Jacobian reuse.
 #[derive(Debug)]
 pub struct GeneralizedAlpha {
@@ -116,7 +129,16 @@ pub struct GeneralizedAlpha {
     pub splits: u64,
     /// Force evaluations, Jacobians included.
     pub evaluations: u64,
+    /// Vectors of accepted steps' old states and pseudo-accelerations, reused by the next
+    /// steps instead of new allocations.
+    spare: Vec<Vec<f64>>,
+    /// The accelerations of an evaluation and the Newton residual (solved in place).
+    f: Vec<f64>,
+    residual: DVector<f64>,
 }
+
+/// Most vectors kept in [`GeneralizedAlpha`]'s pool (a step takes five).
+const SPARE_VECTORS: usize = 8;
 
 impl GeneralizedAlpha {
     /// Parameters from the spectral radius at infinite frequency `rho_inf` in `[0, 1]`
@@ -155,7 +177,24 @@ impl GeneralizedAlpha {
             newton_iterations: 0,
             splits: 0,
             evaluations: 0,
+            spare: Vec::new(),
+            f: Vec::new(),
+            residual: DVector::zeros(0),
         })
+    }
+
+    /// A vector of length `n` (contents unspecified), from the pool if it has one.
+    fn take(&mut self, n: usize) -> Vec<f64> {
+        let mut v = self.spare.pop().unwrap_or_default();
+        v.resize(n, 0.0);
+        v
+    }
+
+    /// Return a vector to the pool.
+    fn give(&mut self, v: Vec<f64>) {
+        if self.spare.len() < SPARE_VECTORS {
+            self.spare.push(v);
+        }
     }
 
     /// `(beta, gamma)` of the Newmark updates.
@@ -209,10 +248,13 @@ impl GeneralizedAlpha {
 
     /// Make `a` the state: its pseudo-acceleration becomes the start of the next step.
     pub fn accept(&mut self, st: &mut State, a: Attempt) {
-        self.p = a.p1;
+        let old_p = std::mem::replace(&mut self.p, a.p1);
         self.p_t = a.next.t;
         self.p_h = a.h;
-        *st = a.next;
+        let old = std::mem::replace(st, a.next);
+        for v in [old_p, a.p0, old.q, old.v, old.a] {
+            self.give(v);
+        }
     }
 
     /// Forget the pseudo-acceleration: the next step starts it again from the acceleration
@@ -222,17 +264,19 @@ impl GeneralizedAlpha {
     }
 
     /// The pseudo-acceleration at the start of a step `h` from `st`.
-    fn p0(&self, st: &State, h: f64) -> Vec<f64> {
+    fn p0(&mut self, st: &State, h: f64) -> Vec<f64> {
+        let mut p0 = self.take(st.a.len());
         if self.p.len() != st.a.len() || self.p_t != st.t {
-            return st.a.clone();
+            p0.copy_from_slice(&st.a);
+        } else if self.p_h == h {
+            p0.copy_from_slice(&self.p);
+        } else {
+            let r = h / self.p_h;
+            for (i, p) in p0.iter_mut().enumerate() {
+                *p = st.a[i] + r * (self.p[i] - st.a[i]);
+            }
         }
-        if self.p_h == h {
-            return self.p.clone();
-        }
-        let r = h / self.p_h;
-        (0..st.a.len())
-            .map(|i| st.a[i] + r * (self.p[i] - st.a[i]))
-            .collect()
+        p0
     }
 
     /// One step of size `h` from `st`, not yet accepted; `Ok(None)` if Newton does not
@@ -264,20 +308,63 @@ impl GeneralizedAlpha {
         h: f64,
     ) -> Result<Option<Attempt>> {
         let n = st.q.len();
-        let (am, af, b, g) = (self.am, self.af, self.beta, self.gamma);
-        let scale = sys.length_scale();
         let p0 = self.p0(st, h);
-        // dq1/da1.
-        let dq_da = b * h * h * (1.0 - af) / (1.0 - am);
         // Start from the old acceleration: the first increment then measures the change over
         // the step, and accepting only a small increment keeps small steps accurate (a
         // predictor that starts closer lets the displacement test, which scales with h^2,
         // accept a poorly converged acceleration at small h).
-        let mut a1 = st.a.clone();
-        let mut p1 = vec![0.0; n];
-        let mut q1 = vec![0.0; n];
-        let mut v1 = vec![0.0; n];
-        let mut f = vec![0.0; n];
+        let mut a1 = self.take(n);
+        a1.copy_from_slice(&st.a);
+        let p1 = self.take(n);
+        let q1 = self.take(n);
+        let v1 = self.take(n);
+        let mut f = std::mem::take(&mut self.f);
+        f.resize(n, 0.0);
+        let mut r = std::mem::replace(&mut self.residual, DVector::zeros(0));
+        if r.len() != n {
+            r = DVector::zeros(n);
+        }
+        let outcome = self.iterate(
+            sys,
+            st,
+            h,
+            Vectors {
+                p0,
+                a1,
+                p1,
+                q1,
+                v1,
+                f: &mut f,
+                r: &mut r,
+            },
+        );
+        self.f = f;
+        self.residual = r;
+        outcome
+    }
+
+    /// The Newton iteration of [`GeneralizedAlpha::newton`] with its vectors.
+    fn iterate<S: MechanicalSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        st: &State,
+        h: f64,
+        vectors: Vectors<'_>,
+    ) -> Result<Option<Attempt>> {
+        let Vectors {
+            p0,
+            mut a1,
+            mut p1,
+            mut q1,
+            mut v1,
+            f,
+            r,
+        } = vectors;
+        let n = st.q.len();
+        let (am, af, b, g) = (self.am, self.af, self.beta, self.gamma);
+        let scale = sys.length_scale();
+        // dq1/da1.
+        let dq_da = b * h * h * (1.0 - af) / (1.0 - am);
         let mut power = [0.0; 3];
         let t1 = st.t + h;
         let Some(lu) = self.lu.as_ref() else {
@@ -296,13 +383,16 @@ impl GeneralizedAlpha {
         let mut theta_step: f64 = 0.0;
         for iteration in 0..self.max_newton {
             update(&a1, &mut p1, &mut q1, &mut v1);
-            sys.eval(t1, &q1, &v1, &mut f, &mut power)?;
+            sys.eval(t1, &q1, &v1, f, &mut power)?;
             self.evaluations += 1;
             self.newton_iterations += 1;
-            let r = DVector::from_fn(n, |i, _| a1[i] - f[i]);
-            let Some(delta) = lu.solve(&r) else {
+            for i in 0..n {
+                r[i] = a1[i] - f[i];
+            }
+            if !lu.solve_mut(r) {
                 return Ok(None);
-            };
+            }
+            let delta = &*r;
             let mut size: f64 = 0.0;
             let mut local: f64 = 0.0;
             for i in 0..n {

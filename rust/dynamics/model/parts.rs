@@ -18,6 +18,10 @@ pub(crate) struct DiscModel {
     pub(crate) phase: f64,
     /// Disc angle offset from the carrier angle, `-phase / zc` [rad].
     pub(crate) angle_offset: f64,
+    /// Cosine and sine of `phase` and of `angle_offset`: a disc's pose turns the crank's and
+    /// the carrier's by them (the trigonometry of an evaluation is then shared by the discs).
+    pub(crate) phase_cs: [f64; 2],
+    pub(crate) offset_cs: [f64; 2],
     /// Body depth of the disc for the line contact law [m]: pin circle radius minus pin
     /// radius (about the distance from the disc centre to a contact).
     pub(crate) body_depth: f64,
@@ -116,10 +120,14 @@ impl Parts {
         let zc = (cyc.pins - 1) as f64;
         let mut discs = Vec::with_capacity(scene.discs.len());
         for (k, d) in scene.discs.iter().enumerate() {
+            let angle_offset = -d.phase / zc;
+            let ((sp, cp), (so, co)) = (d.phase.sin_cos(), angle_offset.sin_cos());
             discs.push(DiscModel {
                 geometry: CycloidGeometry::new(scene.disc_params(k))?,
                 phase: d.phase,
-                angle_offset: -d.phase / zc,
+                angle_offset,
+                phase_cs: [cp, sp],
+                offset_cs: [co, so],
                 body_depth: cyc.pin_circle_radius - cyc.pin_radius,
                 profile_error: d.profile_error.clone().filter(|p| !p.is_empty()),
             });

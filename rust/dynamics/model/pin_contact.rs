@@ -161,7 +161,7 @@ impl PinContact {
 /// kinematic parameter; the parry polyline is the fallback seed. The answer does not depend on
 /// the seed (Newton converges to 1e-13 m on the exact curve): the warm start only saves
 /// iterations. `warm` is updated.
-#[inline]
+#[inline(always)]
 pub(crate) fn pin_query(
     disc: &DiscModel,
     pin: &PinModel,
@@ -188,7 +188,7 @@ pub(crate) fn pin_query(
         let (s, c) = kinematic.sin_cos();
         (kinematic, [c, s])
     };
-    let foot = g.foot_with_fallback_cs(local, seed, cs).ok_or_else(|| {
+    let foot = g.contact_foot(local, seed, cs).ok_or_else(|| {
         // In a run this means the state is unphysical, so it is a simulation failure.
         RvdynError::Simulation(format!(
             "exact gap of pin {} on disc {} not found at t = {t:.6e} s: the disc is farther \
@@ -292,7 +292,7 @@ impl SeparationBound {
 /// given), the exact query, the bound update and the penetration check (when `max_penetration`
 /// is given). `Ok(None)` when the pin does not touch.
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 pub(crate) fn touching_pin(
     disc: &DiscModel,
     pin: &PinModel,

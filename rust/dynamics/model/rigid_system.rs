@@ -4,7 +4,7 @@ use crate::dynamics::model::parts::ShaftLoads;
 use crate::dynamics::model::pin_contact::{first_touch_report, mark_open};
 use crate::dynamics::model::rigid::{CARRIER, CRANK, FULL, Forces, LOAD, MOTOR, RigidModel, SUN};
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
-use crate::dynamics::run::sink::{ContactSink, DynSink, NoSink};
+use crate::dynamics::run::sink::{ContactSink, NoSink};
 use crate::error::Result;
 use crate::solve::MechanicalSystem;
 
@@ -202,24 +202,24 @@ impl ReducerModel for RigidSystem<'_> {
     ) -> Result<Observation> {
         let m = self.model;
         let (x, xv, acc) = self.full(t, q, v);
-        // Keep each planet's mesh force for the crank reactions.
+        // Keep each planet's mesh force for the crank reactions (when they are wanted).
+        let bearings = sink.wants_bearings();
         let sink = &mut MeshCapture {
             inner: sink,
-            force: vec![0.0; m.cranks],
+            force: if bearings {
+                vec![0.0; m.cranks]
+            } else {
+                Vec::new()
+            },
         };
         let (f, qa, sh) = if sink.wants_forces() {
             if m.output_shaft.is_none() && m.input_shaft.is_none() {
                 // No shafts: the reducer's forces alone, called directly (as in `eval`).
-                let f = m.forces(
-                    t,
-                    &[x[0], x[1], x[2]],
-                    &[xv[0], xv[1], xv[2]],
-                    &mut DynSink(sink),
-                )?;
+                let f = m.forces(t, &[x[0], x[1], x[2]], &[xv[0], xv[1], xv[2]], sink)?;
                 let qa = [f.q[0], f.q[1], f.q[2], 0.0, 0.0];
                 (f, qa, ShaftLoads::default())
             } else {
-                self.all_forces(t, &x, &xv, &mut DynSink(sink))?
+                self.all_forces(t, &x, &xv, sink)?
             }
         } else {
             let sh = m.shaft_loads(
@@ -236,7 +236,7 @@ impl ReducerModel for RigidSystem<'_> {
             (None, Some(tq)) => tq,
             (None, None) => 0.0,
         };
-        if sink.wants_forces() {
+        if sink.wants_forces() && bearings {
             // Accelerations of the full coordinates: Q / M of the free ones, the drive's of the
             // prescribed one.
             let mut xa = [0.0; FULL];
@@ -259,8 +259,11 @@ impl ReducerModel for RigidSystem<'_> {
                 sink.bearing(0, i, *r);
             }
         }
-        let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = (0..m.discs.len())
-            .map(|k| m.disc_pose(k, &[x[0], x[1], x[2]]))
+        let crank = x[CRANK].sin_cos();
+        let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = m
+            .discs
+            .iter()
+            .map(|d| (m.disc_centre(d, crank), x[CARRIER] + d.angle_offset))
             .unzip();
         Ok(Observation {
             sun_angle: x[SUN],
@@ -307,7 +310,9 @@ impl ReducerModel for RigidSystem<'_> {
     }
 }
 
-/// A sink that passes everything on and keeps each mesh's force (for the crank reactions).
+/// A sink that passes everything on and keeps each mesh's force (for the crank reactions);
+/// the force routine is instantiated for it, so that a contact reaches the recorder's sink
+/// through one dynamic call.
 struct MeshCapture<'a> {
     inner: &'a mut dyn ContactSink,
     force: Vec<f64>,
@@ -322,6 +327,9 @@ impl ContactSink for MeshCapture<'_> {
     }
     fn checks_bounds(&self) -> bool {
         self.inner.checks_bounds()
+    }
+    fn wants_bearings(&self) -> bool {
+        self.inner.wants_bearings()
     }
     fn pin(
         &mut self,

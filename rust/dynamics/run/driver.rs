@@ -351,11 +351,13 @@ pub fn run_with<M: ReducerModel>(
         record(&mut rec, &st)?;
         next_sample += 1;
     }
+    // The state at the start of the step, kept in place (its vectors are reused).
+    let mut prev = st.clone();
     while st.t < opt.t_end * (1.0 - 1e-14) {
         if control.stopped() {
             return Err(RvdynError::Interrupted);
         }
-        let prev = st.clone();
+        copy_state(&mut prev, &st);
         integrator.advance(sys, &mut st, opt.t_end)?;
         if !st.q.iter().chain(&st.v).all(|v| v.is_finite()) {
             return Err(RvdynError::Simulation(format!(
@@ -398,8 +400,13 @@ pub fn run_with<M: ReducerModel>(
             if ts > st.t + 1e-12 {
                 break;
             }
-            let s = prev.interpolate(&st, ts);
-            record(&mut rec, &s)?;
+            if at_step_end(&prev, &st, ts) {
+                // What the interpolation gives there (its weights are 0 and 1), without a copy.
+                rec.sample(sys, ts, &st.q, &st.v, st.work)?;
+            } else {
+                let s = prev.interpolate(&st, ts);
+                record(&mut rec, &s)?;
+            }
             next_sample += 1;
         }
         control.set_time(st.t);
@@ -413,6 +420,36 @@ pub fn run_with<M: ReducerModel>(
     }
     out.final_state = Some((st.t, st.q, st.v));
     Ok(out)
+}
+
+/// Whether [`State::interpolate`] from `prev` to `next` at `t` is at `next` (its parameter
+/// clamped to 1), where it gives `next`'s coordinates, velocities and work.
+fn at_step_end(prev: &State, next: &State, t: f64) -> bool {
+    let h = next.t - prev.t;
+    if h > 0.0 {
+        (t - prev.t) / h >= 1.0
+    } else {
+        true
+    }
+}
+
+/// `*dst = src.clone()` without new allocations (every field named: a new one fails to compile
+/// here until it is copied).
+fn copy_state(dst: &mut State, src: &State) {
+    let State {
+        t,
+        q,
+        v,
+        a,
+        power,
+        work,
+    } = src;
+    dst.t = *t;
+    dst.q.clone_from(q);
+    dst.v.clone_from(v);
+    dst.a.clone_from(a);
+    dst.power = *power;
+    dst.work = *work;
 }
 
 #[cfg(test)]

@@ -428,6 +428,7 @@ pub(crate) struct SampleSink {
     pub pins: bool,
     pub points: bool,
     pub energy: bool,
+    pub bearings: bool,
     pub force: Vec<f64>,
     pub pen: Vec<f64>,
     pub moment: Vec<f64>,
@@ -449,6 +450,9 @@ impl ContactSink for SampleSink {
     }
     fn checks_bounds(&self) -> bool {
         false
+    }
+    fn wants_bearings(&self) -> bool {
+        self.bearings
     }
     fn pin(
         &mut self,
@@ -530,6 +534,7 @@ impl Recorder {
             pins: has(Channel::Pins),
             points: has(Channel::ContactPoints),
             energy: has(Channel::Energy),
+            bearings: has(Channel::Bearings),
             force: vec![0.0; nd * zp],
             pen: vec![0.0; nd * zp],
             moment: vec![0.0; nd * zp],

@@ -18,6 +18,11 @@ pub trait ContactSink {
     fn checks_bounds(&self) -> bool {
         true
     }
+    /// Whether the bearing forces are wanted: a model that computes them only for the
+    /// report (the rigid model's reactions) skips them when not.
+    fn wants_bearings(&self) -> bool {
+        true
+    }
     /// Pin `j` on disc `k`: normal force [N], penetration [m], moment of the pin force about
     /// the disc centre [N m], contact point and unit outward profile normal (fixed frame).
     #[allow(clippy::too_many_arguments)]
@@ -55,6 +60,9 @@ impl ContactSink for DynSink<'_> {
     }
     fn checks_bounds(&self) -> bool {
         self.0.checks_bounds()
+    }
+    fn wants_bearings(&self) -> bool {
+        self.0.wants_bearings()
     }
     fn pin(
         &mut self,

@@ -2,7 +2,7 @@
 //! load and drive (docs/model.md#compliant-joint-model).
 
 use super::{CARRIER, CompliantModel, Flows, SUN, crank_index};
-use crate::contact::law::PinSite;
+use crate::contact::law::{PinLaw, PinSite};
 use crate::dynamics::model::pin_contact::{
     DiscPose, penetration_error, pin_law_force, touching_pin,
 };
@@ -233,14 +233,17 @@ impl CompliantModel {
                     out.dissipation += p;
                     out.friction[0] += p;
                 }
-                // Location term of a line law (see `PinLaw::location_slope`).
-                if let Some(ls) = m.pin_law.location_slope_at(
-                    lf.elastic,
-                    &site,
-                    pin.centre,
-                    o,
-                    (pose.sin, pose.cos),
-                ) {
+                // Location term of a line law (see `PinLaw::location_slope`; tested for the law
+                // here, not in the call, so that the IMPACT law's evaluations skip the call).
+                if matches!(m.pin_law, PinLaw::Line { .. })
+                    && let Some(ls) = m.pin_law.location_slope_at(
+                        lf.elastic,
+                        &site,
+                        pin.centre,
+                        o,
+                        (pose.sin, pose.cos),
+                    )
+                {
                     let (fo, mt) = ls.forces();
                     qf[dk] += fo[0];
                     qf[dk + 1] += fo[1];
