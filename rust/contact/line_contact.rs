@@ -446,6 +446,9 @@ impl LineContactLaw {
 /// branches are blended for `kappa D` in `[e^-w, e^w] = [0.8, 1.25]`.
 pub const DEPTH_BLEND_HALF_WIDTH: f64 = 0.223_143_551_314_209_76; // ln 1.25
 
+/// `e^-w` of [`DEPTH_BLEND_HALF_WIDTH`]: the lower end 0.8 of the blend in `kappa D`.
+const DEPTH_BLEND_LOWER: f64 = 0.8;
+
 /// The disc's reference depth at a contact and its derivatives along the curvature.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DepthJet {
@@ -478,7 +481,8 @@ pub struct DepthJet {
 pub fn disc_reference_depth(kappa: f64, body_depth: f64) -> DepthJet {
     let w = DEPTH_BLEND_HALF_WIDTH;
     let u = kappa * body_depth;
-    if u.is_nan() || u <= (-w).exp() {
+    // e^-w = 0.8 (the same double as `(-w).exp()`, tested), without an exp per call.
+    if u.is_nan() || u <= DEPTH_BLEND_LOWER {
         return DepthJet {
             depth: body_depth,
             dln_dkappa: 0.0,
@@ -766,6 +770,8 @@ mod tests {
         let d = 0.14;
         let w = DEPTH_BLEND_HALF_WIDTH;
         // Outside the blend: the two branches exactly.
+        assert_eq!((-DEPTH_BLEND_HALF_WIDTH).exp(), DEPTH_BLEND_LOWER);
+        assert_eq!(DEPTH_BLEND_HALF_WIDTH.exp(), 1.25);
         assert_eq!(disc_reference_depth(0.0, d).depth, d);
         assert_eq!(disc_reference_depth(0.79 / d, d).depth, d);
         let k = 1.26 / d;

@@ -486,8 +486,23 @@ impl Statics {
 
     /// Full coordinates from the unknowns `q` with the input held at crank angle `psi`.
     pub fn full(&self, psi: f64, q: &[f64]) -> Vec<f64> {
+        let mut x = Vec::new();
+        self.full_into(psi, q, &mut x);
+        x
+    }
+
+    /// [`Statics::full`] into `x` (resized; no allocation once sized): the coordinates the
+    /// unknowns do not set are the kinematic pose's (the held input, and the crank rotations
+    /// without a first stage), the rest come from `q` as in [`Statics::full`].
+    pub fn full_into(&self, psi: f64, q: &[f64], x: &mut Vec<f64>) {
         let m = &self.model;
-        let mut x = self.kinematic_full(psi);
+        x.clear();
+        x.resize(self.full_len(), 0.0);
+        x[SUN] = if m.mesh.is_some() {
+            self.held_input(psi)
+        } else {
+            0.0
+        };
         match self.kind {
             Kind::Rigid => {
                 let thc = q[0];
@@ -510,6 +525,11 @@ impl Statics {
                 }
             }
             Kind::Compliant => {
+                // Crank rotations held at the crank angle unless they are unknowns (first
+                // stage); carrier, disc and (compliant) crank centre coordinates are unknowns.
+                for i in 0..self.cranks {
+                    x[self.crank_index(i) + 2] = psi;
+                }
                 for (a, &i) in self.unknowns.iter().enumerate() {
                     x[i] = q[a];
                 }
@@ -524,7 +544,6 @@ impl Statics {
                 }
             }
         }
-        x
     }
 
     /// Static generalised forces `qf` and tangent stiffness `kf = -dQ/dx` in the full
@@ -585,11 +604,12 @@ impl Statics {
                 // Skip a pin that provably cannot touch: moving the disc by dO and turning it
                 // by dth moves every profile point by at most |dO| + reach |dth|, and its gap
                 // by no more (the dynamic model's separation bound).
+                // `gap - reach |dth| > |dO|`, compared squared (no hypot per pin).
                 if self.skip && !self.exact {
                     let b = &self.separation[slot];
-                    let moved =
-                        (o[0] - b.0[0]).hypot(o[1] - b.0[1]) + self.reach * (th - b.1).abs();
-                    if b.2 - moved > 0.0 {
+                    let slack = b.2 - self.reach * (th - b.1).abs();
+                    let (dx, dy) = (o[0] - b.0[0], o[1] - b.0[1]);
+                    if slack > 0.0 && dx * dx + dy * dy < slack * slack {
                         self.skipped += 1;
                         if let Some(s) = state.as_deref_mut() {
                             s.pin_force[slot] = 0.0;
@@ -931,14 +951,18 @@ impl Statics {
         work: &mut Work,
         state: Option<&mut ContactState>,
     ) -> Result<()> {
-        let x = self.full(psi, q);
+        let mut x = std::mem::take(&mut work.x);
+        self.full_into(psi, q, &mut x);
         let nf = x.len();
         if work.kf.n != nf {
             work.kf = Dense::zeros(nf);
             work.qf = vec![0.0; nf];
         }
         let (qf, kf) = (&mut work.qf, &mut work.kf);
-        self.full_forces(&x, torque, qf, kf, state)?;
+        let res = self.full_forces(&x, torque, qf, kf, state);
+        work.x = x;
+        res?;
+        let x = &work.x;
         let m = &self.model;
         let n = self.dim();
         // Jacobian columns of the map (sparse: list of (full index, value) per unknown) and
@@ -1164,6 +1188,8 @@ pub struct Work {
     /// Tangent stiffness in the unknowns at the last equilibrium found.
     pub k_last: Dense,
     jac: Vec<Vec<(usize, f64)>>,
+    /// Full coordinates of the last evaluation.
+    x: Vec<f64>,
 }
 
 impl Work {
@@ -1174,6 +1200,7 @@ impl Work {
             kf: Dense::zeros(0),
             k_last: Dense::zeros(0),
             jac: Vec::new(),
+            x: Vec::new(),
         }
     }
 }
