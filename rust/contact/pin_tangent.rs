@@ -451,48 +451,51 @@ pub fn line_jet_with(
     require_positive("disc reference depth", depth, "m")?;
     pin.validate()?;
     disc.validate()?;
-    line_jet_checked(
-        geometry, derivs, pen, pin_radius, depth, pin, disc, ln_guess,
-    )
+    let base = crate::contact::line_contact::PinDiscLawBase::new(
+        pin_radius,
+        geometry.params().face_width,
+        pin,
+        disc,
+    );
+    line_jet_checked(geometry, derivs, pen, &base, depth, depth.ln(), ln_guess)
 }
 
 /// [`line_jet_with`] for a positive finite pin radius and depth and valid materials (checked
-/// once, at the scene's build): the same jet without re-checking them at every contact.
-#[allow(clippy::too_many_arguments)]
+/// once, at the scene's build), given as the contact-independent part `base` of the law and the
+/// body depth `depth` [m] with its logarithm `ln_depth`: the same jet to round-off (one
+/// logarithm fewer per contact, see [`crate::contact::line_contact::PinDiscLawBase`]), without
+/// re-checking the input at every contact.
 #[inline]
 pub(crate) fn line_jet_checked(
     geometry: &CycloidGeometry,
     derivs: &[[f64; 2]; 5],
     pen: f64,
-    pin_radius: f64,
+    base: &crate::contact::line_contact::PinDiscLawBase,
     depth: f64,
-    pin: &crate::contact::Material,
-    disc: &crate::contact::Material,
+    ln_depth: f64,
     ln_guess: f64,
 ) -> Result<LineJet> {
-    use crate::contact::line_contact::{
-        LineContactLaw, disc_reference_depth, profile_curvature_checked,
-    };
+    use crate::contact::line_contact::{disc_reference_depth_ratio, profile_curvature_checked};
     let [kc, kc1, kc2] = curvature_derivatives_of(derivs);
     let r = geometry.generating_pin_radius();
     // kappa_P = kappa_C / (1 - r kappa_C) (`pin_disc_profile_curvature`).
     let k2 = profile_curvature_checked(kc, r)?;
-    let dj = disc_reference_depth(k2, depth);
-    let face_width = geometry.params().face_width;
-    let law = LineContactLaw::pin_disc_checked(pin_radius, k2, dj.depth, face_width, pin, disc)?;
+    // ln h = ln D - ln(D / h).
+    let (dj, ratio) = disc_reference_depth_ratio(k2, depth);
+    let law = base.law(k2, dj.depth, ln_depth - ratio)?;
     let (force, stiffness, ln_force) = law.force_and_stiffness_from(pen, ln_guess);
     let den = 1.0 - r * kc;
     let dk2 = kc1 / (den * den);
     let d2k2 = kc2 / (den * den) + 2.0 * r * kc1 * kc1 / (den * den * den);
-    let sum = 1.0 / pin_radius + k2;
+    let sum = base.pin_curvature() + k2;
     let dln_r = -dk2 / sum;
     let d2ln_r = -d2k2 / sum + dk2 * dk2 / (sum * sum);
     let (dln_h, d2ln_h) = (
         dj.dln_dkappa * dk2,
         dj.dln_dkappa * d2k2 + dj.d2ln_dkappa2 * dk2 * dk2,
     );
-    let (c1, c2) = (pin.compliance(), disc.compliance());
-    let pl = std::f64::consts::PI * face_width;
+    let [c1, c2] = base.compliances();
+    let pl = base.pi_length();
     Ok(LineJet {
         force,
         stiffness,

@@ -24,6 +24,7 @@ use std::f64::consts::TAU;
 use super::gear_errors::FlankError;
 use crate::contact::ImpactLaw;
 use crate::contact::law::{MeshLaw, PinLaw};
+use crate::contact::line_contact::PinDiscLawBase;
 use crate::contact::pin_tangent::{
     GapJet, centre_curve_derivatives_cs, foot_jet_with, gap_jet_cs, line_jet, line_jet_checked,
 };
@@ -186,6 +187,10 @@ pub struct Statics {
     pub mesh_law: Option<MeshLaw>,
     /// `ln F` of each (disc, pin)'s last line-law force (warm start of its inversion).
     ln_warm: Vec<f64>,
+    /// The contact-independent part of each (disc, pin)'s line law (empty for IMPACT).
+    line_bases: Vec<PinDiscLawBase>,
+    /// `ln` of each disc's body depth.
+    ln_body_depth: Vec<f64>,
     seats: Vec<[f64; 2]>,
     /// Actual crank seat of each crank in the carrier frame (with its position error) [m]:
     /// the crank bearing's; the mesh keeps the nominal seat.
@@ -330,7 +335,25 @@ impl Statics {
             }
         };
         let zp = model.pins.len();
+        // Materials, pin radii, face widths and depths were checked with the scene.
+        let line_bases = match &pin_law {
+            PinLaw::Line { pin, disc, .. } => model
+                .discs
+                .iter()
+                .flat_map(|d| {
+                    let w = d.geometry.params().face_width;
+                    model
+                        .pins
+                        .iter()
+                        .map(move |p| PinDiscLawBase::new(p.radius, w, pin, disc))
+                })
+                .collect(),
+            PinLaw::Impact(_) => Vec::new(),
+        };
+        let ln_body_depth = model.discs.iter().map(|d| d.body_depth.ln()).collect();
         Ok(Self {
+            line_bases,
+            ln_body_depth,
             kind,
             eccentric_bearing,
             crank_bearing,
@@ -686,11 +709,7 @@ impl Statics {
                                 c.outer(&idx, &jet.grad, contact_damping(l, pen));
                             }
                         }
-                        PinLaw::Line {
-                            pin: pm,
-                            disc: dm,
-                            damping,
-                        } => {
+                        PinLaw::Line { damping, .. } => {
                             // Line contact: the force depends on the approach and on where
                             // the pin touches (K0(phi)); V = U(pen, phi(x)),
                             // Q = F grad g - U_phi grad phi,
@@ -706,10 +725,9 @@ impl Statics {
                                 &d.geometry,
                                 &cd,
                                 pen,
-                                pin.radius,
+                                &self.line_bases[slot],
                                 d.body_depth,
-                                pm,
-                                dm,
+                                self.ln_body_depth[k],
                                 self.ln_warm[slot],
                             )?;
                             self.ln_warm[slot] = lj.ln_force;
