@@ -107,6 +107,18 @@ impl Dense {
             }
         }
     }
+    /// Replace each entry `v` of the 3x3 block at rows and columns `i0..i0 + 3` by
+    /// `upd(a, b, v)` (`a`, `b` in `0..3`).
+    #[inline]
+    fn update_block3(&mut self, i0: usize, upd: impl Fn(usize, usize, f64) -> f64) {
+        let n = self.n;
+        for a in 0..3 {
+            let start = (i0 + a) * n + i0;
+            for (b, v) in self.a[start..start + 3].iter_mut().enumerate() {
+                *v = upd(a, b, *v);
+            }
+        }
+    }
     /// Add `v` to the symmetric pair `(i, j)`, `(j, i)` (once on the diagonal).
     #[inline]
     fn sym(&mut self, i: usize, j: usize, v: f64) {
@@ -746,18 +758,17 @@ impl Statics {
                                 s.pin_location_moment[slot] =
                                     o[0] * q[1] - o[1] * q[0] - u_phi * fj.grad[2];
                             }
-                            kf.outer(&idx, &jet.grad, lj.stiffness);
-                            kf.outer_sym(&idx, &jet.grad, &fj.grad, -lj.cross());
-                            kf.outer(&idx, &fj.grad, lj.phi_phi());
-                            for a in 0..3 {
-                                for b in 0..3 {
-                                    kf.add(
-                                        idx[a],
-                                        idx[b],
-                                        -f * jet.hess[a][b] + u_phi * fj.hess[a][b],
-                                    );
-                                }
-                            }
+                            // The disc's 3x3 block, each entry updated by the terms in the
+                            // order of `outer`, `outer_sym`, `outer`, `add` (the same
+                            // arithmetic, one pass).
+                            let (g, p) = (&jet.grad, &fj.grad);
+                            let (wk, wc, wp) = (lj.stiffness, -lj.cross(), lj.phi_phi());
+                            kf.update_block3(dk, |a, b, mut v| {
+                                v += (wk * g[a]) * g[b];
+                                v += wc * (g[a] * p[b] + p[a] * g[b]);
+                                v += (wp * p[a]) * p[b];
+                                v + (-f * jet.hess[a][b] + u_phi * fj.hess[a][b])
+                            });
                             if let Some(c) = cf.as_mut() {
                                 c.outer(&idx, &jet.grad, damping.rate_coefficient(f, lj.stiffness));
                             }
@@ -768,12 +779,8 @@ impl Statics {
                     for a in 0..3 {
                         qf[idx[a]] += f * jet.grad[a];
                     }
-                    kf.outer(&idx, &jet.grad, fp);
-                    for a in 0..3 {
-                        for b in 0..3 {
-                            kf.add(idx[a], idx[b], -f * jet.hess[a][b]);
-                        }
-                    }
+                    let g = &jet.grad;
+                    kf.update_block3(dk, |a, b, v| (v + (fp * g[a]) * g[b]) + -f * jet.hess[a][b]);
                 }
                 if let Some(s) = state.as_deref_mut() {
                     // The profile error's share of the force, -F delta' grad phi on the
@@ -1046,12 +1053,15 @@ impl Statics {
             [(i, v)] if *v == 1.0 => Some(*i),
             _ => None,
         };
+        let mut singles = std::mem::take(&mut work.singles);
+        singles.clear();
+        singles.extend(work.jac.iter().map(|c| single(c)));
         for a in 0..n {
             let ja = &work.jac[a];
-            let sa = single(ja);
+            let sa = singles[a];
             for b in 0..n {
                 let jb = &work.jac[b];
-                k.a[a * n + b] = match (sa, single(jb)) {
+                k.a[a * n + b] = match (sa, singles[b]) {
                     (Some(i), Some(j)) => kf.at(i, j),
                     _ => {
                         let mut s = 0.0;
@@ -1065,6 +1075,7 @@ impl Statics {
                 };
             }
         }
+        work.singles = singles;
         // Curvature of the map: slaved crank centres p_i = s_i(th_c) (hess = -s_i) and, for
         // rigid joints, disc centres O_k(alpha) (hess = -O_k).
         if slaved_cranks {
@@ -1206,6 +1217,8 @@ pub struct Work {
     /// Tangent stiffness in the unknowns at the last equilibrium found.
     pub k_last: Dense,
     jac: Vec<Vec<(usize, f64)>>,
+    /// Per Jacobian column, the full coordinate it is when it is one with weight 1.
+    singles: Vec<Option<usize>>,
     /// Full coordinates of the last evaluation.
     x: Vec<f64>,
 }
@@ -1218,6 +1231,7 @@ impl Work {
             kf: Dense::zeros(0),
             k_last: Dense::zeros(0),
             jac: Vec::new(),
+            singles: Vec::new(),
             x: Vec::new(),
         }
     }
