@@ -148,12 +148,19 @@ impl RollerBearing {
     /// A non-finite displacement gives zero force (callers check their state for NaN).
     pub fn state(&self, u: [f64; 2], cage_angle: f64) -> BearingState {
         // A fixed roller set (cage angle 0, the static path) takes the directions as they are:
-        // the rotation by (cos 0, sin 0) = (1, 0) changes no bit of them.
-        let (s, c) = if cage_angle == 0.0 {
-            (0.0, 1.0)
+        // the rotation by (cos 0, sin 0) = (1, 0) would change no bit of them.
+        if cage_angle == 0.0 {
+            self.state_with(u, |d0| *d0)
         } else {
-            cage_angle.sin_cos()
-        };
+            let (s, c) = cage_angle.sin_cos();
+            self.state_with(u, |d0| [c * d0[0] - s * d0[1], s * d0[0] + c * d0[1]])
+        }
+    }
+
+    /// [`RollerBearing::state`] with the roller directions `dir(d0)` of the directions `d0` at
+    /// cage angle 0.
+    #[inline(always)]
+    fn state_with(&self, u: [f64; 2], dir: impl Fn(&[f64; 2]) -> [f64; 2]) -> BearingState {
         let mut st = BearingState {
             force: [0.0, 0.0],
             stiffness: [[0.0; 2]; 2],
@@ -166,7 +173,7 @@ impl RollerBearing {
             return st;
         }
         for d0 in &self.dirs {
-            let n = [c * d0[0] - s * d0[1], s * d0[0] + c * d0[1]];
+            let n = dir(d0);
             let delta = u[0] * n[0] + u[1] * n[1] - self.clearance;
             let (q, k) = self.roller_load(delta);
             if q > 0.0 {

@@ -623,6 +623,13 @@ impl Statics {
             s.mesh_deflection.clear();
             s.crank_bearing_force.clear();
             s.eccentric_bearing_force.clear();
+            // Their final sizes at once (a state handed to a report starts empty).
+            let nc = self.cranks;
+            s.pin_jet.reserve(nd * zp);
+            s.mesh_force.reserve(nc);
+            s.mesh_deflection.reserve(nc);
+            s.crank_bearing_force.reserve(nc);
+            s.eccentric_bearing_force.reserve(nc * nd);
         }
         // Pins.
         for (k, d) in m.discs.iter().enumerate() {
