@@ -1063,9 +1063,24 @@ impl Statics {
         let mut singles = std::mem::take(&mut work.singles);
         singles.clear();
         singles.extend(work.jac.iter().map(|c| single(c)));
+        let nf = kf.n;
         for a in 0..n {
             let ja = &work.jac[a];
             let sa = singles[a];
+            if let Some(i) = sa {
+                // A row of single columns: the entries of row i of K_x as they are.
+                let row = &kf.a[i * nf..i * nf + nf];
+                let out = &mut k.a[a * n..a * n + n];
+                if singles.iter().zip(out.iter_mut()).all(|(sb, o)| match sb {
+                    Some(j) => {
+                        *o = row[*j];
+                        true
+                    }
+                    None => false,
+                }) {
+                    continue;
+                }
+            }
             for b in 0..n {
                 let jb = &work.jac[b];
                 k.a[a * n + b] = match (sa, singles[b]) {
