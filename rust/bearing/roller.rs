@@ -272,7 +272,7 @@ impl RollerBearing {
 /// `[1e-200, 1e200]` (where `y^9` could leave the normal range) and NaN take `powf`.
 #[inline]
 pub(crate) fn ninth_root(x: f64) -> f64 {
-    if !(x >= 1e-200 && x <= 1e200) {
+    if !(1e-200..=1e200).contains(&x) {
         return x.powf(1.0 / 9.0);
     }
     // ln2-linear estimate of the bit pattern: bits(y) ~ bits(x)/9 + (8/9) bits(1.0).

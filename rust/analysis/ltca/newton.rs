@@ -108,7 +108,7 @@ fn cholesky_in(
             lj[k] = s * inv_diag[k];
         }
         let d = dot_from(aj[j], &lj[..j], &lj[..j]);
-        if !(d > tiny) {
+        if d.is_nan() || d <= tiny {
             return None;
         }
         let r = d.sqrt();

@@ -1081,9 +1081,8 @@ impl Statics {
                     continue;
                 }
             }
-            for b in 0..n {
-                let jb = &work.jac[b];
-                k.a[a * n + b] = match (sa, singles[b]) {
+            for (b, (jb, sb)) in work.jac.iter().zip(&singles).enumerate() {
+                k.a[a * n + b] = match (sa, *sb) {
                     (Some(i), Some(j)) => kf.at(i, j),
                     _ => {
                         let mut s = 0.0;
