@@ -124,11 +124,7 @@ impl LineContactLaw {
     ) -> Result<Self> {
         let sum = curvature1 + curvature2;
         if !(sum > 0.0 && sum.is_finite()) {
-            return Err(RvdynError::Geometry(format!(
-                "curvatures {curvature1} 1/m and {curvature2} 1/m add up to {sum} 1/m <= 0: the \
-                 surfaces are concave-concave, conformal or nested and do not make a Hertz line \
-                 contact; a concave surface must be flatter than the convex one it holds"
-            )));
+            return Err(curvature_sum_error(curvature1, curvature2));
         }
         let radius = 1.0 / sum;
         let e_star = effective_modulus(m1, m2);
@@ -202,31 +198,6 @@ impl LineContactLaw {
         }
         let h2 = disc_reference_depth(profile_curvature, disc_depth).depth;
         Self::new(
-            face_width,
-            1.0 / pin_radius,
-            profile_curvature,
-            pin_radius,
-            h2,
-            pin,
-            disc,
-        )
-    }
-
-    /// [`LineContactLaw::pin_disc`] for a positive finite pin radius, valid materials (checked
-    /// once by the caller) and a finite profile curvature, with the disc's reference depth
-    /// `disc_reference_depth(profile_curvature, body depth).depth` given as `h2` [m]: the same
-    /// law without re-checking its input at every contact evaluation. Errors (`Geometry`) for
-    /// a non-positive curvature sum, as [`LineContactLaw::new`].
-    #[inline]
-    pub(crate) fn pin_disc_checked(
-        pin_radius: f64,
-        profile_curvature: f64,
-        h2: f64,
-        face_width: f64,
-        pin: &Material,
-        disc: &Material,
-    ) -> Result<Self> {
-        Self::from_checked(
             face_width,
             1.0 / pin_radius,
             profile_curvature,
@@ -368,7 +339,10 @@ impl LineContactLaw {
     /// `g(x) = x + ln(K0 - K1 x) - ln delta`. `g` is increasing and concave below the validity
     /// limit, so the first Newton step from the limit lands left of the root and the iterates
     /// then increase monotonically to it (no overshoot, no bracketing needed); stops when the
-    /// step is below 1e-15 (relative force error about 1e-15).
+    /// step is below 1e-15 (relative force error about 1e-15), or when the error it leaves,
+    /// bounded by Newton's quadratic convergence `(|g''| / g') step^2` (`g'' = -(K1/q)^2`,
+    /// `q = K0 - K1 x`, with a factor 2 of margin), is below 1e-17 of `|x|` (a tenth of an ulp):
+    /// from a warm start one logarithm fewer for the same result to round-off.
     #[inline]
     pub fn force(&self, delta: f64) -> f64 {
         self.force_and_stiffness(delta).0
@@ -406,13 +380,22 @@ impl LineContactLaw {
         for _ in 0..100 {
             let q = self.k0 - self.k1 * x; // > K1 > 0 for x <= x_lim
             let g = x + q.ln() - ln_d;
-            let dg = 1.0 - self.k1 / q;
+            let r = self.k1 / q;
+            let dg = 1.0 - r;
             let step = g / dg;
             x -= step;
-            if x > x_lim {
+            let clamped = x > x_lim;
+            if clamped {
                 x = x_lim;
             }
-            if step.abs() <= 1e-15 * x.abs().max(1.0) {
+            // Newton's error after this step is (|g''(xi)| / (2 g')) step^2 to leading order,
+            // g'' = -(K1/q)^2; with a factor 2 for xi (q changes by K1 |step| << q there): below
+            // 1e-17 of |x| the iterate is exact to a tenth of its last bit, and the next step
+            // (a logarithm) would change nothing.
+            let scale = x.abs().max(1.0);
+            if step.abs() <= 1e-15 * scale
+                || (!clamped && r * r / dg * step * step <= 1e-17 * scale)
+            {
                 break;
             }
         }
@@ -442,9 +425,139 @@ impl LineContactLaw {
     }
 }
 
+/// The part of a pin-disc line law that does not depend on the contact point (a pin radius, a
+/// face width and the two materials, checked once by the caller): with it the law at a contact
+/// ([`PinDiscLawBase::law`]) takes one logarithm, `ln R`, where
+/// [`LineContactLaw::pin_disc`] takes three (`ln(4 h_k / alpha)` for both bodies and
+/// `ln f_lim`): with `ln alpha = ln sqrt(4 / (pi L E*)) + (ln R) / 2`,
+/// `ln(4 h_k / alpha) = ln 4 + ln h_k - ln alpha` and `ln f_lim = 2 (ln a_lim - ln alpha)`, the
+/// pin's `ln h_1` kept here and the disc's `ln h_2` given. The same law as
+/// [`LineContactLaw::pin_disc`] to round-off (tested).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PinDiscLawBase {
+    length: f64,
+    pin_radius: f64,
+    inv_pin_radius: f64,
+    e_star: f64,
+    compliances: [f64; 2],
+    /// `pi L` [m].
+    pi_length: f64,
+    /// `1 / (pi L E*)` [m/N].
+    k1: f64,
+    /// `ln sqrt(4 / (pi L E*))`.
+    ln_alpha0: f64,
+    /// `ln r_pin`.
+    ln_h1: f64,
+}
+
+impl PinDiscLawBase {
+    /// For a pin of radius `pin_radius` [m] (positive, finite), the face width `face_width` [m]
+    /// (positive, finite) and valid materials.
+    pub(crate) fn new(pin_radius: f64, face_width: f64, pin: &Material, disc: &Material) -> Self {
+        let e_star = effective_modulus(pin, disc);
+        let pi_length = PI * face_width;
+        Self {
+            length: face_width,
+            pin_radius,
+            inv_pin_radius: 1.0 / pin_radius,
+            e_star,
+            compliances: [pin.compliance(), disc.compliance()],
+            pi_length,
+            k1: 1.0 / (pi_length * e_star),
+            ln_alpha0: 0.5 * (4.0 / (pi_length * e_star)).ln(),
+            ln_h1: pin_radius.ln(),
+        }
+    }
+
+    /// `(1 - nu^2)/E` of the pin and of the disc [1/Pa].
+    #[inline]
+    pub(crate) fn compliances(&self) -> [f64; 2] {
+        self.compliances
+    }
+
+    /// `pi L` [m].
+    #[inline]
+    pub(crate) fn pi_length(&self) -> f64 {
+        self.pi_length
+    }
+
+    /// `1 / r_pin` [1/m].
+    #[inline]
+    pub(crate) fn pin_curvature(&self) -> f64 {
+        self.inv_pin_radius
+    }
+
+    /// The law against a disc profile of signed curvature `kappa` [1/m] with the disc's
+    /// reference depth `h2` [m] and its logarithm `ln_h2`. Errors (`Geometry`) for a
+    /// non-positive curvature sum, as [`LineContactLaw::new`].
+    #[inline]
+    pub(crate) fn law(&self, kappa: f64, h2: f64, ln_h2: f64) -> Result<LineContactLaw> {
+        let sum = self.inv_pin_radius + kappa;
+        if !(sum > 0.0 && sum.is_finite()) {
+            return Err(curvature_sum_error(self.inv_pin_radius, kappa));
+        }
+        let radius = 1.0 / sum;
+        let ln_r = -sum.ln();
+        let (length, e_star, c) = (self.length, self.e_star, self.compliances);
+        let alpha = (4.0 * radius / (PI * length * e_star)).sqrt();
+        let ln_alpha = self.ln_alpha0 + 0.5 * ln_r;
+        let ln4 = 2.0 * std::f64::consts::LN_2;
+        let k1 = self.k1;
+        let k0 = (c[0] * (2.0 * (ln4 + self.ln_h1 - ln_alpha) - 1.0)
+            + c[1] * (2.0 * (ln4 + ln_h2 - ln_alpha) - 1.0))
+            / self.pi_length;
+        let (mut a_min, mut ln_a_min) = (self.pin_radius, self.ln_h1);
+        if h2 < a_min {
+            (a_min, ln_a_min) = (h2, ln_h2);
+        }
+        if radius < a_min {
+            (a_min, ln_a_min) = (radius, ln_r);
+        }
+        let a_lim = 0.5 * a_min;
+        let f_lim = (a_lim / alpha).powi(2);
+        let x_lim = 2.0 * (ln_a_min - std::f64::consts::LN_2 - ln_alpha);
+        let delta_lim = f_lim * (k0 - k1 * x_lim);
+        let compliance_lim = k0 - k1 * (1.0 + x_lim);
+        if !(f_lim.is_finite() && delta_lim > 0.0 && compliance_lim > 0.0) {
+            return Err(RvdynError::Parameter(format!(
+                "line contact law out of range (length {length} m, R {radius} m, depths {} m, \
+                 {h2} m)",
+                self.pin_radius
+            )));
+        }
+        Ok(LineContactLaw {
+            length,
+            radius,
+            e_star,
+            depths: [self.pin_radius, h2],
+            compliances: c,
+            k0,
+            k1,
+            alpha,
+            f_lim,
+            x_lim,
+            delta_lim,
+            compliance_lim,
+        })
+    }
+}
+
+/// The `Geometry` error of a non-positive (or non-finite) curvature sum.
+fn curvature_sum_error(curvature1: f64, curvature2: f64) -> RvdynError {
+    let sum = curvature1 + curvature2;
+    RvdynError::Geometry(format!(
+        "curvatures {curvature1} 1/m and {curvature2} 1/m add up to {sum} 1/m <= 0: the \
+         surfaces are concave-concave, conformal or nested and do not make a Hertz line \
+         contact; a concave surface must be flatter than the convex one it holds"
+    ))
+}
+
 /// Half-width `w` of the blend of the disc's reference depth, in `ln(kappa D)`: the two
 /// branches are blended for `kappa D` in `[e^-w, e^w] = [0.8, 1.25]`.
 pub const DEPTH_BLEND_HALF_WIDTH: f64 = 0.223_143_551_314_209_76; // ln 1.25
+
+/// `e^-w` of [`DEPTH_BLEND_HALF_WIDTH`]: the lower end 0.8 of the blend in `kappa D`.
+const DEPTH_BLEND_LOWER: f64 = 0.8;
 
 /// The disc's reference depth at a contact and its derivatives along the curvature.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -476,14 +589,25 @@ pub struct DepthJet {
 /// assert!((convex.depth - 0.094).abs() < 1e-15);
 /// ```
 pub fn disc_reference_depth(kappa: f64, body_depth: f64) -> DepthJet {
+    disc_reference_depth_ratio(kappa, body_depth).0
+}
+
+/// [`disc_reference_depth`] and the ramp `r = ln(D / h)` (0 where `h = D`), so that `ln h` is
+/// `ln D - r` without another logarithm.
+#[inline]
+pub(crate) fn disc_reference_depth_ratio(kappa: f64, body_depth: f64) -> (DepthJet, f64) {
     let w = DEPTH_BLEND_HALF_WIDTH;
     let u = kappa * body_depth;
-    if u.is_nan() || u <= (-w).exp() {
-        return DepthJet {
-            depth: body_depth,
-            dln_dkappa: 0.0,
-            d2ln_dkappa2: 0.0,
-        };
+    // e^-w = 0.8 (the same double as `(-w).exp()`, tested), without an exp per call.
+    if u.is_nan() || u <= DEPTH_BLEND_LOWER {
+        return (
+            DepthJet {
+                depth: body_depth,
+                dln_dkappa: 0.0,
+                d2ln_dkappa2: 0.0,
+            },
+            0.0,
+        );
     }
     let x = u.ln();
     let (r, r1, r2) = if x >= w {
@@ -499,11 +623,14 @@ pub fn disc_reference_depth(kappa: f64, body_depth: f64) -> DepthJet {
         (r, r1, r2)
     };
     // x = ln(kappa D): dx/dkappa = 1/kappa, d2x/dkappa2 = -1/kappa^2.
-    DepthJet {
-        depth: body_depth * (-r).exp(),
-        dln_dkappa: -r1 / kappa,
-        d2ln_dkappa2: (r1 - r2) / (kappa * kappa),
-    }
+    (
+        DepthJet {
+            depth: body_depth * (-r).exp(),
+            dln_dkappa: -r1 / kappa,
+            d2ln_dkappa2: (r1 - r2) / (kappa * kappa),
+        },
+        r,
+    )
 }
 
 /// Signed curvature [1/m] of the actual cycloid profile from the signed curvature
@@ -766,6 +893,8 @@ mod tests {
         let d = 0.14;
         let w = DEPTH_BLEND_HALF_WIDTH;
         // Outside the blend: the two branches exactly.
+        assert_eq!((-DEPTH_BLEND_HALF_WIDTH).exp(), DEPTH_BLEND_LOWER);
+        assert_eq!(DEPTH_BLEND_HALF_WIDTH.exp(), 1.25);
         assert_eq!(disc_reference_depth(0.0, d).depth, d);
         assert_eq!(disc_reference_depth(0.79 / d, d).depth, d);
         let k = 1.26 / d;
@@ -813,5 +942,60 @@ mod tests {
             assert!((lo.dln_dkappa - hi.dln_dkappa).abs() < 1e-9 * d);
             assert!((lo.d2ln_dkappa2 - hi.d2ln_dkappa2).abs() < 1e-8 * d * d);
         }
+    }
+
+    /// The law built from its contact-independent part with one logarithm equals the law of
+    /// the full constructor (three logarithms) to round-off: every coefficient, and force,
+    /// stiffness and `ln F` over the whole range of approaches (including the linear extension
+    /// and from warm and cold starts of the inversion), for convex, concave, blended and
+    /// body-backed contacts and a pin radius that caps the validity limit. Round-off of the
+    /// coefficients: a few ulps of the logarithms (about 20 in size), so 1e-14 relative.
+    #[test]
+    fn law_from_its_base_equals_the_full_constructor() {
+        let (pin, disc) = (STEEL, Material::steel());
+        let body = 0.14;
+        for &(rp, kappa) in &[
+            (0.010, 1.0 / 0.094),
+            (0.010, -1.0 / 0.2),
+            (0.010, 0.9 / body),
+            (0.010, 0.0),
+            (0.004, 1.0 / 0.001),
+            (0.012, 7.0),
+        ] {
+            let full = LineContactLaw::pin_disc(rp, kappa, body, 0.03, &pin, &disc).unwrap();
+            let (dj, ratio) = disc_reference_depth_ratio(kappa, body);
+            assert!(close(dj.depth, body * (-ratio).exp(), 1e-15));
+            let base = PinDiscLawBase::new(rp, 0.03, &pin, &disc);
+            let fast = base.law(kappa, dj.depth, body.ln() - ratio).unwrap();
+            assert_eq!(fast.depths, full.depths);
+            for (a, b) in [
+                (fast.k0, full.k0),
+                (fast.k1, full.k1),
+                (fast.alpha, full.alpha),
+                (fast.f_lim, full.f_lim),
+                (fast.x_lim, full.x_lim),
+                (fast.delta_lim, full.delta_lim),
+                (fast.compliance_lim, full.compliance_lim),
+                (fast.radius, full.radius),
+                (fast.e_star, full.e_star),
+            ] {
+                assert!(close(a, b, 1e-14), "{rp} {kappa}: {a} vs {b}");
+            }
+            for frac in [1e-9, 1e-4, 0.01, 0.3, 0.999, 1.5, 10.0] {
+                let d = frac * full.delta_lim;
+                for guess in [f64::NAN, (0.5 * frac * full.f_lim).ln()] {
+                    let a = fast.force_and_stiffness_from(d, guess);
+                    let b = full.force_and_stiffness_from(d, f64::NAN);
+                    assert!(close(a.0, b.0, 1e-13), "{frac}: {} vs {}", a.0, b.0);
+                    assert!(close(a.1, b.1, 1e-13), "{frac}: {} vs {}", a.1, b.1);
+                    // The force is the inverse of the closed-form approach.
+                    assert!(close(full.approach(a.0).unwrap(), d, 1e-13));
+                }
+            }
+        }
+        // A concave profile as curved as the pin: no Hertz contact, the same error.
+        let base = PinDiscLawBase::new(0.01, 0.03, &pin, &disc);
+        let e = base.law(-100.0, body, body.ln()).unwrap_err();
+        assert!(matches!(e, RvdynError::Geometry(_)), "{e}");
     }
 }

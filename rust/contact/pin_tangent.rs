@@ -144,19 +144,20 @@ pub(crate) fn gap_jet_cs(
         [cc, ss]
     });
     let foot = g.foot_with_fallback_cs(local, seed, cs)?;
-    // One more Newton correction of the foot from a fresh jet (the foot search stops at a
-    // step tolerance: this brings the normal to round-off, which the Hessian needs), then the
-    // curvature of the pin-centre curve there.
-    let jet = g.jet_cs(foot.cos_sin[0], foot.cos_sin[1]);
-    let (d1, d2) = (jet.d1, jet.d2);
-    let rc = [jet.c[0] - local[0], jet.c[1] - local[1]];
+    // One more Newton correction of the foot (the foot search stops at a step tolerance: this
+    // brings the normal to round-off, which the Hessian needs), then the curvature of the
+    // pin-centre curve there. The point and its first two derivatives at the foot are the
+    // search's, moved to its last iterate by their Taylor series (error below 1e-20 m, far
+    // below the round-off of a fresh evaluation), not evaluated again.
+    let (c0, d1, d2) = (foot.centre_point, foot.d1, foot.d2);
+    let rc = [c0[0] - local[0], c0[1] - local[1]];
     let d1sq = d1[0] * d1[0] + d1[1] * d1[1];
     let fp = d1sq + rc[0] * d2[0] + rc[1] * d2[1];
     let dphi = -(rc[0] * d1[0] + rc[1] * d1[1]) / fp;
     let h2 = 0.5 * dphi * dphi;
     let cp = [
-        jet.c[0] + dphi * d1[0] + h2 * d2[0],
-        jet.c[1] + dphi * d1[1] + h2 * d2[1],
+        c0[0] + dphi * d1[0] + h2 * d2[0],
+        c0[1] + dphi * d1[1] + h2 * d2[1],
     ];
     let normal = CycloidGeometry::normal_from_tangent([d1[0] + dphi * d2[0], d1[1] + dphi * d2[1]]);
     let dist = (local[0] - cp[0]) * normal[0] + (local[1] - cp[1]) * normal[1];
@@ -451,48 +452,51 @@ pub fn line_jet_with(
     require_positive("disc reference depth", depth, "m")?;
     pin.validate()?;
     disc.validate()?;
-    line_jet_checked(
-        geometry, derivs, pen, pin_radius, depth, pin, disc, ln_guess,
-    )
+    let base = crate::contact::line_contact::PinDiscLawBase::new(
+        pin_radius,
+        geometry.params().face_width,
+        pin,
+        disc,
+    );
+    line_jet_checked(geometry, derivs, pen, &base, depth, depth.ln(), ln_guess)
 }
 
 /// [`line_jet_with`] for a positive finite pin radius and depth and valid materials (checked
-/// once, at the scene's build): the same jet without re-checking them at every contact.
-#[allow(clippy::too_many_arguments)]
+/// once, at the scene's build), given as the contact-independent part `base` of the law and the
+/// body depth `depth` [m] with its logarithm `ln_depth`: the same jet to round-off (one
+/// logarithm fewer per contact, see [`crate::contact::line_contact::PinDiscLawBase`]), without
+/// re-checking the input at every contact.
 #[inline]
 pub(crate) fn line_jet_checked(
     geometry: &CycloidGeometry,
     derivs: &[[f64; 2]; 5],
     pen: f64,
-    pin_radius: f64,
+    base: &crate::contact::line_contact::PinDiscLawBase,
     depth: f64,
-    pin: &crate::contact::Material,
-    disc: &crate::contact::Material,
+    ln_depth: f64,
     ln_guess: f64,
 ) -> Result<LineJet> {
-    use crate::contact::line_contact::{
-        LineContactLaw, disc_reference_depth, profile_curvature_checked,
-    };
+    use crate::contact::line_contact::{disc_reference_depth_ratio, profile_curvature_checked};
     let [kc, kc1, kc2] = curvature_derivatives_of(derivs);
     let r = geometry.generating_pin_radius();
     // kappa_P = kappa_C / (1 - r kappa_C) (`pin_disc_profile_curvature`).
     let k2 = profile_curvature_checked(kc, r)?;
-    let dj = disc_reference_depth(k2, depth);
-    let face_width = geometry.params().face_width;
-    let law = LineContactLaw::pin_disc_checked(pin_radius, k2, dj.depth, face_width, pin, disc)?;
+    // ln h = ln D - ln(D / h).
+    let (dj, ratio) = disc_reference_depth_ratio(k2, depth);
+    let law = base.law(k2, dj.depth, ln_depth - ratio)?;
     let (force, stiffness, ln_force) = law.force_and_stiffness_from(pen, ln_guess);
     let den = 1.0 - r * kc;
     let dk2 = kc1 / (den * den);
     let d2k2 = kc2 / (den * den) + 2.0 * r * kc1 * kc1 / (den * den * den);
-    let sum = 1.0 / pin_radius + k2;
+    let sum = base.pin_curvature() + k2;
     let dln_r = -dk2 / sum;
     let d2ln_r = -d2k2 / sum + dk2 * dk2 / (sum * sum);
     let (dln_h, d2ln_h) = (
         dj.dln_dkappa * dk2,
         dj.dln_dkappa * d2k2 + dj.d2ln_dkappa2 * dk2 * dk2,
     );
-    let (c1, c2) = (pin.compliance(), disc.compliance());
-    let pl = std::f64::consts::PI * face_width;
+    let [c1, c2] = base.compliances();
+    let pl = base.pi_length();
     Ok(LineJet {
         force,
         stiffness,

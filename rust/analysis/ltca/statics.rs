@@ -24,6 +24,7 @@ use std::f64::consts::TAU;
 use super::gear_errors::FlankError;
 use crate::contact::ImpactLaw;
 use crate::contact::law::{MeshLaw, PinLaw};
+use crate::contact::line_contact::PinDiscLawBase;
 use crate::contact::pin_tangent::{
     GapJet, centre_curve_derivatives_cs, foot_jet_with, gap_jet_cs, line_jet, line_jet_checked,
 };
@@ -103,6 +104,18 @@ impl Dense {
         for (a, &i) in idx.iter().enumerate() {
             for (b, &j) in idx.iter().enumerate() {
                 self.a[i * self.n + j] += w * (u[a] * v[b] + v[a] * u[b]);
+            }
+        }
+    }
+    /// Replace each entry `v` of the 3x3 block at rows and columns `i0..i0 + 3` by
+    /// `upd(a, b, v)` (`a`, `b` in `0..3`).
+    #[inline]
+    fn update_block3(&mut self, i0: usize, upd: impl Fn(usize, usize, f64) -> f64) {
+        let n = self.n;
+        for a in 0..3 {
+            let start = (i0 + a) * n + i0;
+            for (b, v) in self.a[start..start + 3].iter_mut().enumerate() {
+                *v = upd(a, b, *v);
             }
         }
     }
@@ -186,6 +199,10 @@ pub struct Statics {
     pub mesh_law: Option<MeshLaw>,
     /// `ln F` of each (disc, pin)'s last line-law force (warm start of its inversion).
     ln_warm: Vec<f64>,
+    /// The contact-independent part of each (disc, pin)'s line law (empty for IMPACT).
+    line_bases: Vec<PinDiscLawBase>,
+    /// `ln` of each disc's body depth.
+    ln_body_depth: Vec<f64>,
     seats: Vec<[f64; 2]>,
     /// Actual crank seat of each crank in the carrier frame (with its position error) [m]:
     /// the crank bearing's; the mesh keeps the nominal seat.
@@ -330,7 +347,25 @@ impl Statics {
             }
         };
         let zp = model.pins.len();
+        // Materials, pin radii, face widths and depths were checked with the scene.
+        let line_bases = match &pin_law {
+            PinLaw::Line { pin, disc, .. } => model
+                .discs
+                .iter()
+                .flat_map(|d| {
+                    let w = d.geometry.params().face_width;
+                    model
+                        .pins
+                        .iter()
+                        .map(move |p| PinDiscLawBase::new(p.radius, w, pin, disc))
+                })
+                .collect(),
+            PinLaw::Impact(_) => Vec::new(),
+        };
+        let ln_body_depth = model.discs.iter().map(|d| d.body_depth.ln()).collect();
         Ok(Self {
+            line_bases,
+            ln_body_depth,
             kind,
             eccentric_bearing,
             crank_bearing,
@@ -486,8 +521,23 @@ impl Statics {
 
     /// Full coordinates from the unknowns `q` with the input held at crank angle `psi`.
     pub fn full(&self, psi: f64, q: &[f64]) -> Vec<f64> {
+        let mut x = Vec::new();
+        self.full_into(psi, q, &mut x);
+        x
+    }
+
+    /// [`Statics::full`] into `x` (resized; no allocation once sized): the coordinates the
+    /// unknowns do not set are the kinematic pose's (the held input, and the crank rotations
+    /// without a first stage), the rest come from `q` as in [`Statics::full`].
+    pub fn full_into(&self, psi: f64, q: &[f64], x: &mut Vec<f64>) {
         let m = &self.model;
-        let mut x = self.kinematic_full(psi);
+        x.clear();
+        x.resize(self.full_len(), 0.0);
+        x[SUN] = if m.mesh.is_some() {
+            self.held_input(psi)
+        } else {
+            0.0
+        };
         match self.kind {
             Kind::Rigid => {
                 let thc = q[0];
@@ -510,6 +560,11 @@ impl Statics {
                 }
             }
             Kind::Compliant => {
+                // Crank rotations held at the crank angle unless they are unknowns (first
+                // stage); carrier, disc and (compliant) crank centre coordinates are unknowns.
+                for i in 0..self.cranks {
+                    x[self.crank_index(i) + 2] = psi;
+                }
                 for (a, &i) in self.unknowns.iter().enumerate() {
                     x[i] = q[a];
                 }
@@ -524,7 +579,6 @@ impl Statics {
                 }
             }
         }
-        x
     }
 
     /// Static generalised forces `qf` and tangent stiffness `kf = -dQ/dx` in the full
@@ -569,6 +623,13 @@ impl Statics {
             s.mesh_deflection.clear();
             s.crank_bearing_force.clear();
             s.eccentric_bearing_force.clear();
+            // Their final sizes at once (a state handed to a report starts empty).
+            let nc = self.cranks;
+            s.pin_jet.reserve(nd * zp);
+            s.mesh_force.reserve(nc);
+            s.mesh_deflection.reserve(nc);
+            s.crank_bearing_force.reserve(nc);
+            s.eccentric_bearing_force.reserve(nc * nd);
         }
         // Pins.
         for (k, d) in m.discs.iter().enumerate() {
@@ -585,11 +646,12 @@ impl Statics {
                 // Skip a pin that provably cannot touch: moving the disc by dO and turning it
                 // by dth moves every profile point by at most |dO| + reach |dth|, and its gap
                 // by no more (the dynamic model's separation bound).
+                // `gap - reach |dth| > |dO|`, compared squared (no hypot per pin).
                 if self.skip && !self.exact {
                     let b = &self.separation[slot];
-                    let moved =
-                        (o[0] - b.0[0]).hypot(o[1] - b.0[1]) + self.reach * (th - b.1).abs();
-                    if b.2 - moved > 0.0 {
+                    let slack = b.2 - self.reach * (th - b.1).abs();
+                    let (dx, dy) = (o[0] - b.0[0], o[1] - b.0[1]);
+                    if slack > 0.0 && dx * dx + dy * dy < slack * slack {
                         self.skipped += 1;
                         if let Some(s) = state.as_deref_mut() {
                             s.pin_force[slot] = 0.0;
@@ -666,11 +728,7 @@ impl Statics {
                                 c.outer(&idx, &jet.grad, contact_damping(l, pen));
                             }
                         }
-                        PinLaw::Line {
-                            pin: pm,
-                            disc: dm,
-                            damping,
-                        } => {
+                        PinLaw::Line { damping, .. } => {
                             // Line contact: the force depends on the approach and on where
                             // the pin touches (K0(phi)); V = U(pen, phi(x)),
                             // Q = F grad g - U_phi grad phi,
@@ -686,10 +744,9 @@ impl Statics {
                                 &d.geometry,
                                 &cd,
                                 pen,
-                                pin.radius,
+                                &self.line_bases[slot],
                                 d.body_depth,
-                                pm,
-                                dm,
+                                self.ln_body_depth[k],
                                 self.ln_warm[slot],
                             )?;
                             self.ln_warm[slot] = lj.ln_force;
@@ -708,18 +765,17 @@ impl Statics {
                                 s.pin_location_moment[slot] =
                                     o[0] * q[1] - o[1] * q[0] - u_phi * fj.grad[2];
                             }
-                            kf.outer(&idx, &jet.grad, lj.stiffness);
-                            kf.outer_sym(&idx, &jet.grad, &fj.grad, -lj.cross());
-                            kf.outer(&idx, &fj.grad, lj.phi_phi());
-                            for a in 0..3 {
-                                for b in 0..3 {
-                                    kf.add(
-                                        idx[a],
-                                        idx[b],
-                                        -f * jet.hess[a][b] + u_phi * fj.hess[a][b],
-                                    );
-                                }
-                            }
+                            // The disc's 3x3 block, each entry updated by the terms in the
+                            // order of `outer`, `outer_sym`, `outer`, `add` (the same
+                            // arithmetic, one pass).
+                            let (g, p) = (&jet.grad, &fj.grad);
+                            let (wk, wc, wp) = (lj.stiffness, -lj.cross(), lj.phi_phi());
+                            kf.update_block3(dk, |a, b, mut v| {
+                                v += (wk * g[a]) * g[b];
+                                v += wc * (g[a] * p[b] + p[a] * g[b]);
+                                v += (wp * p[a]) * p[b];
+                                v + (-f * jet.hess[a][b] + u_phi * fj.hess[a][b])
+                            });
                             if let Some(c) = cf.as_mut() {
                                 c.outer(&idx, &jet.grad, damping.rate_coefficient(f, lj.stiffness));
                             }
@@ -730,12 +786,8 @@ impl Statics {
                     for a in 0..3 {
                         qf[idx[a]] += f * jet.grad[a];
                     }
-                    kf.outer(&idx, &jet.grad, fp);
-                    for a in 0..3 {
-                        for b in 0..3 {
-                            kf.add(idx[a], idx[b], -f * jet.hess[a][b]);
-                        }
-                    }
+                    let g = &jet.grad;
+                    kf.update_block3(dk, |a, b, v| (v + (fp * g[a]) * g[b]) + -f * jet.hess[a][b]);
                 }
                 if let Some(s) = state.as_deref_mut() {
                     // The profile error's share of the force, -F delta' grad phi on the
@@ -931,14 +983,18 @@ impl Statics {
         work: &mut Work,
         state: Option<&mut ContactState>,
     ) -> Result<()> {
-        let x = self.full(psi, q);
+        let mut x = std::mem::take(&mut work.x);
+        self.full_into(psi, q, &mut x);
         let nf = x.len();
         if work.kf.n != nf {
             work.kf = Dense::zeros(nf);
             work.qf = vec![0.0; nf];
         }
         let (qf, kf) = (&mut work.qf, &mut work.kf);
-        self.full_forces(&x, torque, qf, kf, state)?;
+        let res = self.full_forces(&x, torque, qf, kf, state);
+        work.x = x;
+        res?;
+        let x = &work.x;
         let m = &self.model;
         let n = self.dim();
         // Jacobian columns of the map (sparse: list of (full index, value) per unknown) and
@@ -1004,12 +1060,29 @@ impl Statics {
             [(i, v)] if *v == 1.0 => Some(*i),
             _ => None,
         };
+        let mut singles = std::mem::take(&mut work.singles);
+        singles.clear();
+        singles.extend(work.jac.iter().map(|c| single(c)));
+        let nf = kf.n;
         for a in 0..n {
             let ja = &work.jac[a];
-            let sa = single(ja);
-            for b in 0..n {
-                let jb = &work.jac[b];
-                k.a[a * n + b] = match (sa, single(jb)) {
+            let sa = singles[a];
+            if let Some(i) = sa {
+                // A row of single columns: the entries of row i of K_x as they are.
+                let row = &kf.a[i * nf..i * nf + nf];
+                let out = &mut k.a[a * n..a * n + n];
+                if singles.iter().zip(out.iter_mut()).all(|(sb, o)| match sb {
+                    Some(j) => {
+                        *o = row[*j];
+                        true
+                    }
+                    None => false,
+                }) {
+                    continue;
+                }
+            }
+            for (b, (jb, sb)) in work.jac.iter().zip(&singles).enumerate() {
+                k.a[a * n + b] = match (sa, *sb) {
                     (Some(i), Some(j)) => kf.at(i, j),
                     _ => {
                         let mut s = 0.0;
@@ -1023,6 +1096,7 @@ impl Statics {
                 };
             }
         }
+        work.singles = singles;
         // Curvature of the map: slaved crank centres p_i = s_i(th_c) (hess = -s_i) and, for
         // rigid joints, disc centres O_k(alpha) (hess = -O_k).
         if slaved_cranks {
@@ -1164,6 +1238,10 @@ pub struct Work {
     /// Tangent stiffness in the unknowns at the last equilibrium found.
     pub k_last: Dense,
     jac: Vec<Vec<(usize, f64)>>,
+    /// Per Jacobian column, the full coordinate it is when it is one with weight 1.
+    singles: Vec<Option<usize>>,
+    /// Full coordinates of the last evaluation.
+    x: Vec<f64>,
 }
 
 impl Work {
@@ -1174,6 +1252,8 @@ impl Work {
             kf: Dense::zeros(0),
             k_last: Dense::zeros(0),
             jac: Vec::new(),
+            singles: Vec::new(),
+            x: Vec::new(),
         }
     }
 }
