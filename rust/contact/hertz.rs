@@ -159,9 +159,7 @@ pub fn hertz_line_contact(
     // whose results are representable: a = sqrt(P) sqrt(4R/(pi E*)),
     // p0 = 2P/(pi a) = sqrt(P) sqrt(E*/(pi R)), ln(4|R_k|/a) = ln(4|R_k|) - ln(a) with
     // ln(a) = (ln P + ln(4R/(pi E*)))/2 (P = 5e-324 N/m gives a ~ 1e-168 m, not 0).
-    let sqrt_p = p.sqrt();
-    let a = sqrt_p * (4.0 * r / (PI * e_star)).sqrt();
-    let p0 = sqrt_p * (e_star / (PI * r)).sqrt();
+    let (a, p0) = hertz_line_strip(p, r, e_star);
     let ln_a = 0.5 * (p.ln() + (4.0 * r / (PI * e_star)).ln());
     let deflection = |m: &Material, rk: f64| {
         p * m.compliance() / PI * (2.0 * ((4.0 * rk.abs()).ln() - ln_a) - 1.0)
@@ -186,6 +184,28 @@ pub fn hertz_line_contact(
         )));
     }
     Ok(c)
+}
+
+/// Half-width `a` [m] and peak pressure `p0` [Pa] of the Hertz line contact under the line
+/// load `p` [N/m] (`p >= 0`), effective radius `r` [m] (`> 0`) and effective modulus `e_star`
+/// [Pa] (`> 0`): `a = sqrt(p) sqrt(4 r / (pi E*))`, `p0 = sqrt(p) sqrt(E* / (pi r))`
+/// (`= 2 p / (pi a)`), the strip of [`hertz_line_contact`] without its checks or the approach
+/// (for inputs checked once, as the LTCA's report does per loaded pin).
+///
+/// ```
+/// use rvdyn::contact::hertz::{hertz_line_contact, hertz_line_strip, effective_modulus, Material};
+/// let steel = Material::steel();
+/// let (a, p0) = hertz_line_strip(1e6, 0.01, effective_modulus(&steel, &steel));
+/// let full = hertz_line_contact(1e4, 0.01, 0.02, 0.02, &steel, &steel).unwrap();
+/// assert!((a - full.half_width).abs() < 1e-15 && (p0 - full.peak_pressure).abs() < 1e-3);
+/// ```
+#[inline]
+pub fn hertz_line_strip(p: f64, r: f64, e_star: f64) -> (f64, f64) {
+    let sqrt_p = p.sqrt();
+    (
+        sqrt_p * (4.0 * r / (PI * e_star)).sqrt(),
+        sqrt_p * (e_star / (PI * r)).sqrt(),
+    )
 }
 
 /// Palmgren's coefficient 3.84e-5 mm N^-0.9 mm^0.8 (steel roller against raceway).

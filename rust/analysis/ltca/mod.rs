@@ -19,7 +19,7 @@ pub mod statics;
 
 use std::f64::consts::{PI, TAU};
 
-use crate::contact::hertz::{Material, hertz_line_contact};
+use crate::contact::hertz::{Material, effective_modulus, hertz_line_strip};
 use crate::dynamics::scene::Scene;
 use crate::error::{Result, RvdynError, require_finite};
 pub use newton::{NewtonOptions, NewtonReport};
@@ -467,9 +467,9 @@ impl Ltca {
         let kin = st.kinematic_full(psi);
         let m = &st.model;
         let zp = m.pins.len();
-        let (pin_mat, disc_mat) = match &m.pin_law {
-            crate::contact::law::PinLaw::Line { pin, disc, .. } => (*pin, *disc),
-            _ => (Material::steel(), Material::steel()),
+        let e_star = match &m.pin_law {
+            crate::contact::law::PinLaw::Line { pin, disc, .. } => effective_modulus(pin, disc),
+            _ => effective_modulus(&Material::steel(), &Material::steel()),
         };
         let mut pins = Vec::with_capacity(m.discs.len());
         let mut loaded = Vec::new();
@@ -497,16 +497,11 @@ impl Ltca {
                         -jet.gap
                     )));
                 }
-                let (hw, p0) = if f > 0.0 {
-                    hertz_line_contact(
-                        f,
-                        self.face_width,
-                        m.pins[j].radius,
-                        jet.curvature_radius,
-                        &pin_mat,
-                        &disc_mat,
-                    )
-                    .map_or((0.0, 0.0), |h| (h.half_width, h.peak_pressure))
+                // Materials and face width are checked with the scene: the strip alone. No
+                // strip for a conformal contact (no positive effective radius).
+                let inv_r = 1.0 / m.pins[j].radius + 1.0 / jet.curvature_radius;
+                let (hw, p0) = if f > 0.0 && inv_r.is_finite() && inv_r > 0.0 {
+                    hertz_line_strip(f / self.face_width, 1.0 / inv_r, e_star)
                 } else {
                     (0.0, 0.0)
                 };
@@ -540,7 +535,7 @@ impl Ltca {
         } else {
             psi
         };
-        Ok(LtcaPoint {
+        let point = LtcaPoint {
             crank_angle: psi,
             torque,
             output_angle: x[CARRIER],
@@ -551,14 +546,18 @@ impl Ltca {
             loaded_pins: loaded,
             disc_rotation: rot,
             disc_displacement: disp,
-            mesh_force: cs.mesh_force,
-            crank_bearing_force: cs.crank_bearing_force,
-            eccentric_bearing_force: cs.eccentric_bearing_force,
+            mesh_force: cs.mesh_force.clone(),
+            crank_bearing_force: cs.crank_bearing_force.clone(),
+            eccentric_bearing_force: cs.eccentric_bearing_force.clone(),
             torque_balance: balance,
             residual: rep.residual,
             iterations: rep.iterations,
             torsional_stiffness: stiff,
-        })
+        };
+        // The contact state's buffers go back to Newton's scratch (no allocation at the next
+        // capture).
+        self.scratch.state = cs;
+        Ok(point)
     }
 
     /// Transmission error over one mesh period at `points` crank angles, at `+-torque`

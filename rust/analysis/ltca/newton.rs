@@ -79,6 +79,16 @@ fn symmetric(m: &[f64], n: usize, tol: f64) -> bool {
 /// if a pivot `d_j = L_jj^2` is not above `tiny` (not positive definite to working accuracy):
 /// the caller then eliminates with pivoting.
 fn cholesky_solve(m: &[f64], n: usize, b: &mut [f64], tiny: f64) -> Option<bool> {
+    // The LTCA's sizes, with the loop bounds known to the compiler (no bounds checks).
+    macro_rules! fixed {
+        ($($n:literal)*) => {
+            match n {
+                $($n => return cholesky_fixed::<$n>(m, b, tiny),)*
+                _ => {}
+            }
+        };
+    }
+    fixed!(4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20);
     CHOLESKY_SCRATCH.with_borrow_mut(|scratch| {
         if scratch.len() < n * n + 2 * n {
             scratch.resize(n * n + 2 * n, 0.0);
@@ -87,6 +97,51 @@ fn cholesky_solve(m: &[f64], n: usize, b: &mut [f64], tiny: f64) -> Option<bool>
         let (inv_diag, y) = rest.split_at_mut(n);
         cholesky_in(m, n, b, tiny, l, inv_diag, &mut y[..n])
     })
+}
+
+/// [`cholesky_solve`] for `N x N` on the stack: the same operations in the same order as
+/// [`cholesky_in`] (the same results bit for bit).
+fn cholesky_fixed<const N: usize>(m: &[f64], b: &mut [f64], tiny: f64) -> Option<bool> {
+    let m = m.get(..N * N)?;
+    let b: &mut [f64; N] = b.get_mut(..N)?.try_into().ok()?;
+    let mut l = [[0.0f64; N]; N];
+    let mut inv_diag = [0.0f64; N];
+    for j in 0..N {
+        for k in 0..j {
+            let mut s = m[j * N + k];
+            for i in 0..k {
+                s -= l[j][i] * l[k][i];
+            }
+            l[j][k] = s * inv_diag[k];
+        }
+        let mut d = m[j * N + j];
+        for i in 0..j {
+            d -= l[j][i] * l[j][i];
+        }
+        if d.is_nan() || d <= tiny {
+            return None;
+        }
+        let r = d.sqrt();
+        l[j][j] = r;
+        inv_diag[j] = 1.0 / r;
+    }
+    let mut y = [0.0f64; N];
+    for j in 0..N {
+        let mut s = b[j];
+        for i in 0..j {
+            s -= l[j][i] * y[i];
+        }
+        y[j] = s * inv_diag[j];
+    }
+    for j in (0..N).rev() {
+        let xj = y[j] * inv_diag[j];
+        y[j] = xj;
+        for i in 0..j {
+            y[i] -= l[j][i] * xj;
+        }
+    }
+    *b = y;
+    Some(b.iter().all(|v| v.is_finite()))
 }
 
 /// [`cholesky_solve`] with its scratch: `l` (`n * n`), `inv_diag` and `y` (`n` each).
@@ -544,6 +599,46 @@ mod tests {
     /// (LU path) and a symmetric indefinite one (Cholesky fails, LU takes over) to the same
     /// tolerance; the Cholesky and LU results of one matrix agree to 1e-12; non-finite entries
     /// and singular symmetric matrices are refused.
+    /// The fixed-size Cholesky gives the general one's solution bit for bit (the same
+    /// operations in the same order), for every size it covers, on symmetric positive definite
+    /// matrices `B B^T + n I` with a known solution, which both reproduce to 1e-12.
+    #[test]
+    fn fixed_size_cholesky_equals_the_general_one() {
+        let mut seed = 7u64;
+        let mut rnd = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for n in 1..=22 {
+            let bm: Vec<f64> = (0..n * n).map(|_| rnd()).collect();
+            let mut m = vec![0.0; n * n];
+            for i in 0..n {
+                for j in 0..n {
+                    let s: f64 = (0..n).map(|k| bm[i * n + k] * bm[j * n + k]).sum();
+                    m[i * n + j] = s + if i == j { n as f64 } else { 0.0 };
+                }
+            }
+            let x: Vec<f64> = (0..n).map(|_| rnd()).collect();
+            let b: Vec<f64> = (0..n)
+                .map(|i| (0..n).map(|j| m[i * n + j] * x[j]).sum())
+                .collect();
+            let mut via_dispatch = b.clone();
+            assert_eq!(cholesky_solve(&m, n, &mut via_dispatch, 1e-14), Some(true));
+            let (mut l, mut inv, mut y) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
+            let mut general = b.clone();
+            assert_eq!(
+                cholesky_in(&m, n, &mut general, 1e-14, &mut l, &mut inv, &mut y),
+                Some(true)
+            );
+            assert_eq!(via_dispatch, general, "size {n}");
+            for (g, w) in general.iter().zip(&x) {
+                assert!((g - w).abs() < 1e-12, "size {n}: {g} against {w}");
+            }
+        }
+    }
+
     #[test]
     fn symmetric_and_general_solves_match_known_solutions() {
         let mut state = 99u64;

@@ -811,3 +811,66 @@ fn warm_start_extrapolates_polynomials_of_its_degree() {
     let q = predictor(&h, &st, 0.75, 100.0, st.kinematic_unknowns(0.75));
     close(&q, 0.75, 100.0, &|_, _| last, 1e-9);
 }
+
+/// The report's Hertz strip of each loaded pin (half-width and peak pressure) is the checked
+/// Hertz line contact (`hertz_line_contact`) at the pin radius and the profile's radius of
+/// curvature from an independent exact gap query at the reported disc pose; unloaded pins have
+/// none.
+#[test]
+fn report_hertz_strips_equal_the_checked_hertz_contact() {
+    use crate::contact::hertz::hertz_line_contact;
+    use crate::contact::law::PinLaw;
+    use crate::contact::pin_tangent::pin_gap_jet;
+    let scene = Scene::physical("rated").unwrap();
+    let torque = scene.load.torque(0.0);
+    let mut ltca = Ltca::new(&scene).unwrap();
+    let st = Statics::new(&scene).unwrap();
+    let PinLaw::Line { pin, disc, .. } = &st.model.pin_law else {
+        panic!("the physical preset has the line law")
+    };
+    let (pin_mat, disc_mat) = (*pin, *disc);
+    for psi in [0.0, 0.1, 0.23] {
+        let p = ltca.solve(torque, psi).unwrap();
+        let kin = st.kinematic_full(psi);
+        let mut checked = 0;
+        for k in 0..2 {
+            let dk = st.disc_index(k);
+            let o = [
+                kin[dk] + p.disc_displacement[k][0],
+                kin[dk + 1] + p.disc_displacement[k][1],
+            ];
+            let th = kin[dk + 2] + p.disc_rotation[k];
+            let d = &st.model.discs[k];
+            for (j, l) in p.pins[k].iter().enumerate() {
+                if l.force <= 0.0 {
+                    assert_eq!((l.half_width, l.peak_pressure), (0.0, 0.0));
+                    continue;
+                }
+                let pin = &st.model.pins[j];
+                let seed = pin.angle - th - d.geometry.params().d_delta;
+                let jet = pin_gap_jet(&d.geometry, pin.centre, pin.radius, o, th, seed).unwrap();
+                let h = hertz_line_contact(
+                    l.force,
+                    scene.cycloid.face_width,
+                    pin.radius,
+                    jet.curvature_radius,
+                    &pin_mat,
+                    &disc_mat,
+                )
+                .unwrap();
+                let rel = |a: f64, b: f64| (a - b).abs() / b;
+                assert!(
+                    rel(l.half_width, h.half_width) < 1e-9
+                        && rel(l.peak_pressure, h.peak_pressure) < 1e-9,
+                    "pin {j} disc {k}: strip ({}, {}) against ({}, {})",
+                    l.half_width,
+                    l.peak_pressure,
+                    h.half_width,
+                    h.peak_pressure
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked >= 10, "only {checked} loaded pins at {psi}");
+    }
+}
