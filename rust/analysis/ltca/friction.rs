@@ -663,11 +663,7 @@ impl Ltca {
                 .filter(|(s, _)| s.signum() == t.signum())
                 .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
             {
-                self.history = vec![super::Solved {
-                    psi,
-                    torque: *t0,
-                    q: q0.clone(),
-                }];
+                self.history = vec![super::Solved::new(&self.statics, psi, *t0, q0.clone())];
             }
             let near = (t.abs() < 1e-6 * rated).then_some(rated);
             match self.friction_twist(laws, t, psi, d, near) {

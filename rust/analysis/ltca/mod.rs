@@ -159,6 +159,25 @@ struct Solved {
     psi: f64,
     torque: f64,
     q: Vec<f64>,
+    /// `q` minus the kinematic unknowns at `psi` (what the warm start extrapolates).
+    deflection: Vec<f64>,
+}
+
+impl Solved {
+    fn new(st: &Statics, psi: f64, torque: f64, q: Vec<f64>) -> Self {
+        let kin = st.kinematic_unknowns(psi);
+        Self::with_kinematic(psi, torque, q, &kin)
+    }
+
+    fn with_kinematic(psi: f64, torque: f64, q: Vec<f64>, kin: &[f64]) -> Self {
+        let deflection = q.iter().zip(kin).map(|(a, b)| a - b).collect();
+        Self {
+            psi,
+            torque,
+            q,
+            deflection,
+        }
+    }
 }
 
 /// Previous solutions kept for the warm start.
@@ -174,7 +193,7 @@ const HISTORY: usize = 3;
 /// roller opens or closes every few steps and the deflection's curvature jumps there, it
 /// costs 10 % more than the linear one, also when used only between solutions with the same
 /// pins touching.
-fn predictor(history: &[Solved], st: &Statics, psi: f64, torque: f64, kin: Vec<f64>) -> Vec<f64> {
+fn predictor(history: &[Solved], psi: f64, torque: f64, kin: Vec<f64>) -> Vec<f64> {
     let Some(last) = history.first() else {
         return kin;
     };
@@ -203,18 +222,14 @@ fn predictor(history: &[Solved], st: &Statics, psi: f64, torque: f64, kin: Vec<f
     if s.len() >= 2 && (target - s[0]).abs() > 1.5 * (s[0] - s[1]).abs() {
         s.truncate(1);
     }
-    let deflection = |p: &Solved| -> Vec<f64> {
-        let k = st.kinematic_unknowns(p.psi);
-        p.q.iter().zip(&k).map(|(a, b)| a - b).collect()
-    };
-    let d0 = deflection(last);
+    let d0 = &last.deflection;
     let mut out = kin;
     if s.len() == 2 {
         // Linear: d0 + w (d0 - d1), summed in this order as before the quadratic was added
         // (the light-load solves' iteration counts follow round-off).
-        let d1 = deflection(&history[1]);
+        let d1 = &history[1].deflection;
         let w = (target - s[0]) / (s[0] - s[1]);
-        for (o, (a, b)) in out.iter_mut().zip(d0.iter().zip(&d1)) {
+        for (o, (a, b)) in out.iter_mut().zip(d0.iter().zip(d1)) {
             let k = *o;
             *o = k + a + w * (a - b);
         }
@@ -225,13 +240,13 @@ fn predictor(history: &[Solved], st: &Statics, psi: f64, torque: f64, kin: Vec<f
                 .map(|m| (target - s[m]) / (s[j] - s[m]))
                 .product()
         };
-        let (d1, d2) = (deflection(&history[1]), deflection(&history[2]));
+        let (d1, d2) = (&history[1].deflection, &history[2].deflection);
         let w = [lagrange(0), lagrange(1), lagrange(2)];
         for (i, o) in out.iter_mut().enumerate() {
             *o += w[0] * d0[i] + w[1] * d1[i] + w[2] * d2[i];
         }
     } else {
-        for (o, a) in out.iter_mut().zip(&d0) {
+        for (o, a) in out.iter_mut().zip(d0) {
             *o += a;
         }
     }
@@ -329,11 +344,12 @@ impl Ltca {
         require_finite("crank angle", psi)?;
         let st = &mut self.statics;
         let kin = st.kinematic_unknowns(psi);
+        let kin_here = kin.clone();
         // Warm start: the previous solutions' deflections from their kinematic poses carried to
         // this one; with two or three previous solutions along the same torque (or the same
         // crank angle), extrapolated by the polynomial through them in the crank angle (or the
         // torque).
-        let mut q = predictor(&self.history, st, psi, torque, kin);
+        let mut q = predictor(&self.history, psi, torque, kin);
         let rep = match equilibrium(
             st,
             psi,
@@ -369,14 +385,8 @@ impl Ltca {
         if self.history.len() == HISTORY {
             self.history.pop();
         }
-        self.history.insert(
-            0,
-            Solved {
-                psi,
-                torque,
-                q: q.clone(),
-            },
-        );
+        self.history
+            .insert(0, Solved::with_kinematic(psi, torque, q.clone(), &kin_here));
         Ok((q, rep))
     }
 
@@ -710,11 +720,7 @@ impl Ltca {
                 .filter(|(s, _)| s.signum() == t.signum())
                 .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
             {
-                self.history = vec![Solved {
-                    psi,
-                    torque: *t0,
-                    q: q0.clone(),
-                }];
+                self.history = vec![Solved::new(&self.statics, psi, *t0, q0.clone())];
             }
             if t.abs() < 1e-6 * rated {
                 self.solve_near_zero(t, psi, rated)?;

@@ -106,18 +106,13 @@ fn cholesky_fixed<const N: usize>(m: &[f64], b: &mut [f64], tiny: f64) -> Option
     let b: &mut [f64; N] = b.get_mut(..N)?.try_into().ok()?;
     let mut l = [[0.0f64; N]; N];
     let mut inv_diag = [0.0f64; N];
+    let sub = |s: f64, a: &[f64], b: &[f64]| a.iter().zip(b).fold(s, |s, (x, y)| s - x * y);
     for j in 0..N {
         for k in 0..j {
-            let mut s = m[j * N + k];
-            for i in 0..k {
-                s -= l[j][i] * l[k][i];
-            }
+            let s = sub(m[j * N + k], &l[j][..k], &l[k][..k]);
             l[j][k] = s * inv_diag[k];
         }
-        let mut d = m[j * N + j];
-        for i in 0..j {
-            d -= l[j][i] * l[j][i];
-        }
+        let d = sub(m[j * N + j], &l[j][..j], &l[j][..j]);
         if d.is_nan() || d <= tiny {
             return None;
         }
@@ -127,17 +122,13 @@ fn cholesky_fixed<const N: usize>(m: &[f64], b: &mut [f64], tiny: f64) -> Option
     }
     let mut y = [0.0f64; N];
     for j in 0..N {
-        let mut s = b[j];
-        for i in 0..j {
-            s -= l[j][i] * y[i];
-        }
-        y[j] = s * inv_diag[j];
+        y[j] = sub(b[j], &l[j][..j], &y[..j]) * inv_diag[j];
     }
     for j in (0..N).rev() {
         let xj = y[j] * inv_diag[j];
         y[j] = xj;
-        for i in 0..j {
-            y[i] -= l[j][i] * xj;
+        for (v, x) in y[..j].iter_mut().zip(&l[j][..j]) {
+            *v -= x * xj;
         }
     }
     *b = y;

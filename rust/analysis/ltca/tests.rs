@@ -755,15 +755,14 @@ fn warm_start_extrapolates_polynomials_of_its_degree() {
     let st = Statics::new(&Scene::paper("rated").unwrap()).unwrap();
     let n = st.dim();
     let shape: Vec<f64> = (0..n).map(|a| 1e-6 * (1.0 + a as f64)).collect();
-    let point = |psi: f64, torque: f64, d: &dyn Fn(f64, f64) -> f64| Solved {
-        psi,
-        torque,
-        q: st
+    let point = |psi: f64, torque: f64, d: &dyn Fn(f64, f64) -> f64| {
+        let q = st
             .kinematic_unknowns(psi)
             .iter()
             .zip(&shape)
             .map(|(k, s)| k + s * d(psi, torque))
-            .collect(),
+            .collect();
+        Solved::new(&st, psi, torque, q)
     };
     let close = |got: &[f64], psi: f64, torque: f64, d: &dyn Fn(f64, f64) -> f64, tol: f64| {
         let want = point(psi, torque, d).q;
@@ -781,7 +780,7 @@ fn warm_start_extrapolates_polynomials_of_its_degree() {
         .iter()
         .map(|&t| point(0.7, t, &quad))
         .collect();
-    let q = predictor(&h, &st, 0.7, 3600.0, st.kinematic_unknowns(0.7));
+    let q = predictor(&h, 0.7, 3600.0, st.kinematic_unknowns(0.7));
     close(&q, 0.7, 3600.0, &quad, 1e-9);
     // The same history with a linear deflection along the crank angle: linear is exact there,
     // a quadratic one is not (so the degree is the one documented).
@@ -791,24 +790,24 @@ fn warm_start_extrapolates_polynomials_of_its_degree() {
         .iter()
         .map(|&p| point(p, 5000.0, &lin))
         .collect();
-    let q = predictor(&h, &st, 0.73, 5000.0, st.kinematic_unknowns(0.73));
+    let q = predictor(&h, 0.73, 5000.0, st.kinematic_unknowns(0.73));
     close(&q, 0.73, 5000.0, &lin, 1e-9);
     let h: Vec<Solved> = [0.72, 0.71, 0.70]
         .iter()
         .map(|&p| point(p, 5000.0, &curved))
         .collect();
-    let q = predictor(&h, &st, 0.73, 5000.0, st.kinematic_unknowns(0.73));
+    let q = predictor(&h, 0.73, 5000.0, st.kinematic_unknowns(0.73));
     let want = point(0.73, 5000.0, &curved).q;
     let off = (q[0] - want[0]) / shape[0];
     // Linear extrapolation through two points one step h ahead errs by h^2 f'' = 1e-4 for
     // f = 0.5 p^2, h = 0.01 (below the truth).
     assert!((off + 1e-4).abs() < 1e-9, "linear predictor error {off:e}");
     // Two steps and a half ahead: no extrapolation, the last deflection.
-    let q = predictor(&h, &st, 0.745, 5000.0, st.kinematic_unknowns(0.745));
+    let q = predictor(&h, 0.745, 5000.0, st.kinematic_unknowns(0.745));
     let last = 0.2 + 0.5 * 0.72 * 0.72;
     close(&q, 0.745, 5000.0, &|_, _| last, 1e-9);
     // Neither the torque nor the crank angle shared: the last deflection.
-    let q = predictor(&h, &st, 0.75, 100.0, st.kinematic_unknowns(0.75));
+    let q = predictor(&h, 0.75, 100.0, st.kinematic_unknowns(0.75));
     close(&q, 0.75, 100.0, &|_, _| last, 1e-9);
 }
 
