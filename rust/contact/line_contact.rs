@@ -138,10 +138,43 @@ impl LineContactLaw {
             / (PI * length);
         let a_lim = 0.5 * depth1.min(depth2).min(radius);
         let f_lim = (a_lim / alpha).powi(2);
-        let x_lim = f_lim.ln();
+        Self::from_coefficients(
+            length,
+            radius,
+            e_star,
+            depths,
+            compliances,
+            [k0, k1, alpha],
+            f_lim,
+            f_lim.ln(),
+        )
+    }
+
+    /// The law from its coefficients `[K0, K1, alpha]` and validity limit `f_lim` [N] with
+    /// `x_lim = ln f_lim`: the approach and compliance at the limit, and an error (never a
+    /// NaN) for coefficients beyond floating-point range. With `a <= h/2` every log term is
+    /// `>= ln 8 > 1`, so this cannot fail for finite input.
+    #[allow(clippy::too_many_arguments)]
+    fn from_coefficients(
+        length: f64,
+        radius: f64,
+        e_star: f64,
+        depths: [f64; 2],
+        compliances: [f64; 2],
+        [k0, k1, alpha]: [f64; 3],
+        f_lim: f64,
+        x_lim: f64,
+    ) -> Result<Self> {
         let delta_lim = f_lim * (k0 - k1 * x_lim);
         let compliance_lim = k0 - k1 * (1.0 + x_lim);
-        let law = Self {
+        if !(f_lim.is_finite() && delta_lim > 0.0 && compliance_lim > 0.0) {
+            return Err(RvdynError::Parameter(format!(
+                "line contact law out of range (length {length} m, R {radius} m, depths {} m, \
+                 {} m)",
+                depths[0], depths[1]
+            )));
+        }
+        Ok(Self {
             length,
             radius,
             e_star,
@@ -154,16 +187,7 @@ impl LineContactLaw {
             x_lim,
             delta_lim,
             compliance_lim,
-        };
-        if !(f_lim.is_finite() && delta_lim > 0.0 && compliance_lim > 0.0) {
-            // With a <= h/2 every log term is >= ln 8 > 1, so this cannot happen for finite
-            // input; kept so that an overflow is an error and never a NaN.
-            return Err(RvdynError::Parameter(format!(
-                "line contact law out of range (length {length} m, R {radius} m, depths \
-                 {depth1} m, {depth2} m)"
-            )));
-        }
-        Ok(law)
+        })
     }
 
     /// The law of a pin of radius `pin_radius` [m] against a disc profile of signed curvature
@@ -516,29 +540,16 @@ impl PinDiscLawBase {
         let a_lim = 0.5 * a_min;
         let f_lim = (a_lim / alpha).powi(2);
         let x_lim = 2.0 * (ln_a_min - std::f64::consts::LN_2 - ln_alpha);
-        let delta_lim = f_lim * (k0 - k1 * x_lim);
-        let compliance_lim = k0 - k1 * (1.0 + x_lim);
-        if !(f_lim.is_finite() && delta_lim > 0.0 && compliance_lim > 0.0) {
-            return Err(RvdynError::Parameter(format!(
-                "line contact law out of range (length {length} m, R {radius} m, depths {} m, \
-                 {h2} m)",
-                self.pin_radius
-            )));
-        }
-        Ok(LineContactLaw {
+        LineContactLaw::from_coefficients(
             length,
             radius,
             e_star,
-            depths: [self.pin_radius, h2],
-            compliances: c,
-            k0,
-            k1,
-            alpha,
+            [self.pin_radius, h2],
+            c,
+            [k0, k1, alpha],
             f_lim,
             x_lim,
-            delta_lim,
-            compliance_lim,
-        })
+        )
     }
 }
 

@@ -563,6 +563,17 @@ fn not_converged(psi: f64, torque: f64, residual: f64, it: usize) -> RvdynError 
 mod tests {
     use super::*;
 
+    /// Uniform numbers in [-0.5, 0.5) from a 64-bit linear congruential generator (Knuth's
+    /// MMIX constants), reproducible from `seed`.
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
+        }
+    }
+
     #[test]
     fn dense_solve_matches_a_known_system_and_flags_singular() {
         let mut a = Dense {
@@ -582,26 +593,12 @@ mod tests {
         assert!(!solve_dense(&mut s, &mut [1.0, 1.0]));
     }
 
-    /// Both paths of the solver (Cholesky for symmetric positive definite matrices, LU with
-    /// pivoting for the rest) against known solutions: `b = A x` for a chosen `x`, on random
-    /// matrices of size 16 (the physical preset's unknowns) and 23. Positive definite
-    /// `A = B B^T + I` with condition numbers up to about 1e3 (residual of the solution 1e-12
-    /// relative, i.e. round-off times the condition); the same matrix with a 1e-3 asymmetry
-    /// (LU path) and a symmetric indefinite one (Cholesky fails, LU takes over) to the same
-    /// tolerance; the Cholesky and LU results of one matrix agree to 1e-12; non-finite entries
-    /// and singular symmetric matrices are refused.
     /// The fixed-size Cholesky gives the general one's solution bit for bit (the same
     /// operations in the same order), for every size it covers, on symmetric positive definite
     /// matrices `B B^T + n I` with a known solution, which both reproduce to 1e-12.
     #[test]
     fn fixed_size_cholesky_equals_the_general_one() {
-        let mut seed = 7u64;
-        let mut rnd = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = uniform(7);
         for n in 1..=22 {
             let bm: Vec<f64> = (0..n * n).map(|_| rnd()).collect();
             let mut m = vec![0.0; n * n];
@@ -630,15 +627,17 @@ mod tests {
         }
     }
 
+    /// Both paths of the solver (Cholesky for symmetric positive definite matrices, LU with
+    /// pivoting for the rest) against known solutions: `b = A x` for a chosen `x`, on random
+    /// matrices of size 16 (the physical preset's unknowns) and 23. Positive definite
+    /// `A = B B^T + I` with condition numbers up to about 1e3 (residual of the solution 1e-12
+    /// relative, i.e. round-off times the condition); the same matrix with a 1e-3 asymmetry
+    /// (LU path) and a symmetric indefinite one (Cholesky fails, LU takes over) to the same
+    /// tolerance; the Cholesky and LU results of one matrix agree to 1e-12; non-finite entries
+    /// and singular symmetric matrices are refused.
     #[test]
     fn symmetric_and_general_solves_match_known_solutions() {
-        let mut state = 99u64;
-        let mut rnd = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
-        };
+        let mut rnd = uniform(99);
         for n in [16usize, 23] {
             let bm: Vec<f64> = (0..n * n).map(|_| rnd()).collect();
             let mut spd = Dense::zeros(n);
