@@ -293,18 +293,9 @@ impl Ltca {
         slip: Option<&Slip>,
     ) -> Result<Eval> {
         let n = self.statics.dim();
-        let mut r = vec![0.0; n];
-        let mut k = Dense::zeros(n);
-        let mut cs = ContactState::default();
-        self.statics.eval(
-            psi,
-            q,
-            torque,
-            &mut r,
-            &mut k,
-            &mut self.work,
-            Some(&mut cs),
-        )?;
+        let (mut r, k, cs) = self
+            .statics
+            .eval_fresh(psi, q, torque, &mut self.work, false)?;
         let mut rf = vec![0.0; n];
         if let Some(slip) = slip {
             let x = self.statics.full(psi, q);

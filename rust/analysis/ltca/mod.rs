@@ -450,21 +450,7 @@ impl Ltca {
         } else {
             // Not the state Newton just captured (another caller's unknowns): evaluate afresh,
             // every pin queried.
-            let mut r = vec![0.0; n];
-            let mut k = statics::Dense::zeros(n);
-            let mut cs = statics::ContactState::default();
-            st.exact = true;
-            let evaluated = st.eval(
-                psi,
-                q,
-                torque,
-                &mut r,
-                &mut k,
-                &mut self.work,
-                Some(&mut cs),
-            );
-            st.exact = false;
-            evaluated?;
+            let (_, k, cs) = st.eval_fresh(psi, q, torque, &mut self.work, true)?;
             (cs, k)
         };
         let mut e0 = vec![0.0; n];

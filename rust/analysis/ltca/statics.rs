@@ -1118,6 +1118,29 @@ impl Statics {
         Ok(())
     }
 
+    /// A fresh [`Statics::eval`] at `q` into new buffers: the residual [N], the tangent and the
+    /// contact state. With `every_pin`, no pin is skipped by the separation bound (exact gaps
+    /// of every pin, as a report needs).
+    pub fn eval_fresh(
+        &mut self,
+        psi: f64,
+        q: &[f64],
+        torque: f64,
+        work: &mut Work,
+        every_pin: bool,
+    ) -> Result<(Vec<f64>, Dense, ContactState)> {
+        let n = self.dim();
+        let mut r = vec![0.0; n];
+        let mut k = Dense::zeros(n);
+        let mut cs = ContactState::default();
+        let before = self.exact;
+        self.exact = every_pin || before;
+        let evaluated = self.eval(psi, q, torque, &mut r, &mut k, work, Some(&mut cs));
+        self.exact = before;
+        evaluated?;
+        Ok((r, k, cs))
+    }
+
     /// `out = J^T v` of a full-coordinate force `v` with the map Jacobian of the last
     /// [`Statics::eval`] (the friction forces of `ltca::friction`).
     pub fn reduce_force(&self, v: &[f64], work: &Work, out: &mut [f64]) {
@@ -1682,6 +1705,43 @@ mod tests {
             assert!(worst == 0.0, "skipping changes the forces by {worst:e}");
             assert!(skipped > 1000, "{skipped}");
         }
+    }
+
+    /// `eval_fresh` with `every_pin` gives exactly the evaluation of a model that never skips
+    /// a pin (residual, tangent and every pin's gap), also right after evaluations that
+    /// skipped pins, and leaves the skip setting as it was; without it, the gaps of skipped
+    /// pins are their last exact ones.
+    #[test]
+    fn fresh_evaluation_of_every_pin_equals_a_non_skipping_one() {
+        let mut scene = Scene::paper("rated").unwrap();
+        scene.cycloid.d_rrp = 2e-5;
+        scene.cycloid.d_rp = -2e-5;
+        scene.joints = crate::dynamics::compliant::default_joints();
+        let mut skipping = Statics::new(&scene).unwrap();
+        let mut never = Statics::new(&scene).unwrap();
+        never.skip = false;
+        let n = skipping.dim();
+        let (mut r, mut k) = (vec![0.0; n], Dense::zeros(n));
+        let mut work = Work::new();
+        let psi = 0.1;
+        let mut q = skipping.kinematic_unknowns(psi);
+        q[0] -= 2e-4;
+        skipping
+            .eval(psi, &q, 4e4, &mut r, &mut k, &mut work, None)
+            .unwrap();
+        q[0] -= 1e-7;
+        let skipped_before = skipping.skipped;
+        let (r1, k1, cs1) = skipping.eval_fresh(psi, &q, 4e4, &mut work, true).unwrap();
+        assert_eq!(skipping.skipped, skipped_before, "no pin skipped");
+        assert!(!skipping.exact);
+        let (r2, k2, cs2) = never.eval_fresh(psi, &q, 4e4, &mut work, false).unwrap();
+        assert_eq!(r1, r2);
+        assert_eq!(k1.a, k2.a);
+        assert_eq!(cs1.pin_gap, cs2.pin_gap);
+        // Without every_pin the skip applies again.
+        q[0] -= 1e-7;
+        skipping.eval_fresh(psi, &q, 4e4, &mut work, false).unwrap();
+        assert!(skipping.skipped > skipped_before);
     }
 
     /// The tangent stiffness equals central differences of the static forces.
