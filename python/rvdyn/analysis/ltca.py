@@ -276,7 +276,10 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
          chunk: int = 360) -> LtcaResult:
     """Loaded tooth contact analysis of ``scene`` under the output ``torque`` [N m] (default:
     the scene's constant load) at ``crank_angles`` [rad] (default: 90 angles over one mesh
-    period), each equilibrium warm-started from the previous.
+    period), each equilibrium warm-started from the previous. Runs of at least 300 angles
+    (per ``chunk``) are solved as parallel chains of at least 150 consecutive angles, each
+    later chain started from the kinematic pose (docs/model.md, "Long sweeps in parallel
+    chains"): the results do not depend on the number of threads.
 
     Raises ``ConvergenceError`` (naming the crank angle and residual) when no equilibrium is
     found, ``ParameterError`` for non-finite input.

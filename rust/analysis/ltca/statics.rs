@@ -240,6 +240,9 @@ pub struct Statics {
     last_jets: Vec<GapJet>,
     /// `(cos, sin)` of each pin's nominal angle.
     pin_dirs: Vec<[f64; 2]>,
+    /// `(cos, sin)` of each disc's angle at the current evaluation (the pins' and the
+    /// eccentric bearings' one `sin_cos` per disc).
+    disc_cs: Vec<[f64; 2]>,
     /// Largest distance of a profile point from its disc centre [m].
     reach: f64,
     /// Bound of each disc's profile error `|delta| <= bound` [m] (0 without one): the
@@ -392,6 +395,7 @@ impl Statics {
             separation: vec![([0.0; 2], 0.0, f64::NEG_INFINITY); nd * zp],
             last_jets: vec![GapJet::default(); nd * zp],
             pin_dirs: model.pins.iter().map(|p| cos_sin(p.angle)).collect(),
+            disc_cs: vec![[1.0, 0.0]; nd],
             reach: (0..nd)
                 .map(|k| {
                     let p = scene.disc_params(k);
@@ -637,6 +641,7 @@ impl Statics {
             let o = [x[dk], x[dk + 1]];
             let th = x[dk + 2];
             let cs = cos_sin(th);
+            self.disc_cs[k] = cs;
             // (cos, sin) of -(theta + d_delta), to turn each pin's angle into its kinematic
             // foot parameter without a sin_cos per pin.
             let back = cos_sin(-th - d.geometry.params().d_delta);
@@ -929,7 +934,7 @@ impl Statics {
                         let e = self.ecc_radius[i];
                         [e * c[0], e * c[1]]
                     };
-                    let arm = rotate(cos_sin(x[dk + 2]), self.holes[i * nd + k]);
+                    let arm = rotate(self.disc_cs[k], self.holes[i * nd + k]);
                     let d = [
                         x[dk] + arm[0] - p[0] - ecc[0],
                         x[dk + 1] + arm[1] - p[1] - ecc[1],
@@ -1195,6 +1200,8 @@ impl Statics {
             let o = [x[dk], x[dk + 1]];
             let th = x[dk + 2];
             let cs_th = cos_sin(th);
+            // The seed's (cos, sin) as in `full_forces` (no sin_cos per pin).
+            let back = cos_sin(-th - d.geometry.params().d_delta);
             for (j, pin) in m.pins.iter().enumerate() {
                 let slot = k * zp + j;
                 let b = &self.separation[slot];
@@ -1203,6 +1210,9 @@ impl Statics {
                 }
                 let kin = pin.angle - th - d.geometry.params().d_delta;
                 let w = &mut self.warm[slot];
+                let kcs = rotate(back, self.pin_dirs[j]);
+                let (ds, dc) = small_sin_cos(*w);
+                let scs = [kcs[0] * dc - kcs[1] * ds, kcs[1] * dc + kcs[0] * ds];
                 let jet = gap_jet_cs(
                     &d.geometry,
                     pin.centre,
@@ -1210,7 +1220,7 @@ impl Statics {
                     o,
                     cs_th,
                     kin + *w,
-                    None,
+                    Some(scs),
                 )
                 .ok_or_else(|| no_foot(k, j))?;
                 let off = jet.phi - kin;

@@ -873,3 +873,64 @@ fn report_hertz_strips_equal_the_checked_hertz_contact() {
         assert!(checked >= 10, "only {checked} loaded pins at {psi}");
     }
 }
+
+/// A sweep of `2 SWEEP_CHAIN` angles runs as two chains in parallel (the second from the
+/// kinematic pose): the same bits on one thread as on two, and the same equilibria as one
+/// unbroken chain of single solves to the Newton tolerance. Tolerances: forces 1e-9 of the
+/// peak and TE 1e-13 rad (both chains' residuals are below `1e-12 |T| / rp`; measured
+/// differences 3.4e-12 of the peak force and 2e-16 rad).
+#[test]
+fn parallel_chains_equal_one_unbroken_sweep() {
+    let mut s = Scene::paper("rated").unwrap();
+    s.joints = default_joints();
+    s.contact.pin = ContactLawSpec::Palmgren {
+        max_damping: 1e5,
+        damping_depth: 1e-5,
+    };
+    let n = 2 * SWEEP_CHAIN;
+    let period = Ltca::new(&s).unwrap().mesh_period();
+    let angles: Vec<f64> = (0..n).map(|i| period * i as f64 / n as f64).collect();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut l = Ltca::new(&s).unwrap();
+            let pts = l.sweep(rated(), &angles).unwrap();
+            (pts, l.evaluations(), l.last_unknowns().to_vec())
+        })
+    };
+    let (one, e1, q1) = run(1);
+    let (two, e2, q2) = run(2);
+    assert_eq!(e1, e2);
+    assert_eq!(q1, q2);
+    for (a, b) in one.iter().zip(&two) {
+        assert_eq!(a.transmission_error, b.transmission_error);
+        assert_eq!(a.pins, b.pins);
+    }
+    let mut l = Ltca::new(&s).unwrap();
+    let unbroken: Vec<LtcaPoint> = angles
+        .iter()
+        .map(|&p| l.solve(rated(), p).unwrap())
+        .collect();
+    // The second chain's start from the kinematic pose costs evaluations.
+    assert!(e1 > l.evaluations(), "{e1} {}", l.evaluations());
+    let peak = unbroken
+        .iter()
+        .map(|p| p.peak_pin_force())
+        .fold(0.0, f64::max);
+    for (a, b) in one.iter().zip(&unbroken) {
+        assert_eq!(a.loaded_pins, b.loaded_pins);
+        assert!((a.transmission_error - b.transmission_error).abs() < 1e-13);
+        for (ra, rb) in a.pins.iter().zip(&b.pins) {
+            for (pa, pb) in ra.iter().zip(rb) {
+                assert!((pa.force - pb.force).abs() < 1e-9 * peak);
+            }
+        }
+    }
+    // The warm start afterwards is the last angle's solution.
+    for (a, b) in q1.iter().zip(l.last_unknowns()) {
+        assert!((a - b).abs() < 1e-12, "{a} {b}");
+    }
+}
