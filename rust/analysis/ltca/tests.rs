@@ -934,3 +934,35 @@ fn parallel_chains_equal_one_unbroken_sweep() {
         assert!((a - b).abs() < 1e-12, "{a} {b}");
     }
 }
+
+/// A chain whose start from the kinematic pose fails (here: Newton limited to fewer
+/// iterations than that start needs, but enough for the warm-started angles) is solved again
+/// as the continuation of the chain before it: the sweep succeeds with exactly the unbroken
+/// chain's results.
+#[test]
+fn a_chain_that_fails_from_the_kinematic_pose_continues_the_one_before() {
+    let mut s = Scene::paper("rated").unwrap();
+    s.joints = default_joints();
+    let n = 2 * SWEEP_CHAIN;
+    let mut warm = Ltca::new(&s).unwrap();
+    let period = warm.mesh_period();
+    let angles: Vec<f64> = (0..n).map(|i| period * i as f64 / n as f64).collect();
+    warm.solve(rated(), -period / n as f64).unwrap();
+    let cold_iterations = {
+        let mut l = Ltca::new(&s).unwrap();
+        l.solve(rated(), angles[n / 2]).unwrap().iterations
+    };
+    warm.options.max_iterations = 4;
+    assert!(
+        cold_iterations > warm.options.max_iterations,
+        "{cold_iterations}"
+    );
+    let mut unbroken = warm.clone();
+    let expected = unbroken.sweep_chain(rated(), &angles).unwrap();
+    let e_unbroken = unbroken.evaluations();
+    let got = warm.sweep(rated(), &angles).unwrap();
+    assert_eq!(got, expected);
+    assert_eq!(warm.last_unknowns(), unbroken.last_unknowns());
+    // The failed cold start's evaluations are counted.
+    assert!(warm.evaluations() > e_unbroken);
+}
