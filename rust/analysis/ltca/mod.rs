@@ -154,6 +154,16 @@ pub struct TwistLoop {
     pub tangent_stiffness: Vec<f64>,
 }
 
+/// One point of the frictionless torque-twist loop: its index along the loop, the torque
+/// solved (1e-7 rated at a zero of the loop), twist, tangent stiffness and unknowns.
+struct LoopPoint {
+    index: usize,
+    torque: f64,
+    twist: f64,
+    tangent: f64,
+    q: Vec<f64>,
+}
+
 /// A solved equilibrium kept for warm starts.
 #[derive(Debug, Clone)]
 struct Solved {
@@ -750,30 +760,73 @@ impl Ltca {
         }
         let (torque, rated) = friction::loop_torques(rated, points)?;
         self.reset();
-        let mut twist = Vec::with_capacity(points);
-        let mut tangent = Vec::with_capacity(points);
         // At zero torque the equilibrium is any pose inside the clearances: the loop takes the
         // limit along its branch (a torque of 1e-7 rated on the side it comes from; the elastic
         // twist at that torque is ~(1e-7)^(2/3) = 2e-5 of the rated one for Hertz contacts).
         let eps = 1e-7 * rated;
         let mut side = 1.0;
-        let mut solved: Vec<(f64, Vec<f64>)> = Vec::with_capacity(points);
-        for &t in &torque {
-            let ts = if t == 0.0 { side * eps } else { t };
-            if t != 0.0 {
-                side = t.signum();
-            }
+        let sides: Vec<f64> = torque
+            .iter()
+            .map(|&t| {
+                if t != 0.0 {
+                    side = t.signum();
+                }
+                side
+            })
+            .collect();
+        // Without friction the equilibrium at a torque does not depend on the path to it, so
+        // the loop runs as two chains on two threads: its first part (0 -> +rated -> 0) in
+        // order, and the rest (the negative torques) from its most loaded point outwards, each
+        // point warm-started from its neighbour on the chain. The cut depends on the torques
+        // only: the same results on any number of threads.
+        let split = torque.iter().position(|&t| t < 0.0).unwrap_or(points);
+        let point = |l: &mut Ltca, i: usize| -> Result<LoopPoint> {
+            let t = torque[i];
+            let ts = if t == 0.0 { sides[i] * eps } else { t };
             let (q, _) = if t == 0.0 {
-                self.solve_near_zero(ts, psi, rated)?
+                l.solve_near_zero(ts, psi, rated)?
             } else {
-                self.solve_unknowns(ts, psi)?
+                l.solve_unknowns(ts, psi)?
             };
-            solved.push((ts, q.clone()));
-            let x = self.statics.full(psi, &q);
-            // Twist positive with positive torque: the load turns the output backwards.
-            twist.push(-(x[CARRIER] + psi / self.statics.zc()));
-            tangent.push(self.last_tangent_stiffness());
-        }
+            let x = l.statics.full(psi, &q);
+            Ok(LoopPoint {
+                index: i,
+                torque: ts,
+                // Twist positive with positive torque: the load turns the output backwards.
+                twist: -(x[CARRIER] + psi / l.statics.zc()),
+                tangent: l.last_tangent_stiffness(),
+                q,
+            })
+        };
+        let mut other = self.clone();
+        let evaluations = self.statics.evaluations;
+        let (first, rest) = rayon::join(
+            || -> Result<Vec<LoopPoint>> { (0..split).map(|i| point(self, i)).collect() },
+            || -> Result<Vec<LoopPoint>> {
+                let Some(peak) = (split..points)
+                    .max_by(|&a, &b| torque[a].abs().total_cmp(&torque[b].abs()).then(b.cmp(&a)))
+                else {
+                    return Ok(Vec::new());
+                };
+                let mut out = vec![point(&mut other, peak)?];
+                let at_peak = other.history.clone();
+                for i in (split..peak).rev() {
+                    out.push(point(&mut other, i)?);
+                }
+                other.history = at_peak;
+                for i in peak + 1..points {
+                    out.push(point(&mut other, i)?);
+                }
+                Ok(out)
+            },
+        );
+        self.statics.evaluations += other.statics.evaluations - evaluations;
+        let mut all = first?;
+        all.extend(rest?);
+        all.sort_by_key(|p| p.index);
+        let twist: Vec<f64> = all.iter().map(|p| p.twist).collect();
+        let tangent: Vec<f64> = all.iter().map(|p| p.tangent).collect();
+        let solved: Vec<(f64, Vec<f64>)> = all.into_iter().map(|p| (p.torque, p.q)).collect();
         // The catalogue points, each warm-started from the loop point nearest in torque on the
         // same side of zero.
         let mut at = |t: f64| -> Result<f64> {
@@ -794,7 +847,6 @@ impl Ltca {
         let rigidity = 2.0 * rated / (at(rated)? - at(-rated)?);
         let lost_motion = at(0.03 * rated)? - at(-0.03 * rated)?;
         let backlash = at(eps)? - at(-eps)?;
-        let _ = side;
         Ok(TwistLoop {
             crank_angle: psi,
             torque,

@@ -966,3 +966,34 @@ fn a_chain_that_fails_from_the_kinematic_pose_continues_the_one_before() {
     // The failed cold start's evaluations are counted.
     assert!(warm.evaluations() > e_unbroken);
 }
+
+/// The frictionless loop runs as two chains (the positive part in order, the negative part
+/// from its most loaded point outwards): the same bits on one thread as on two, and the same
+/// twist as the loop solved in order (the frictional loop's path with no friction, which
+/// `zero_friction_gives_the_closed_loop` also checks) to 1e-12 rad.
+#[test]
+fn the_two_chain_loop_is_the_same_on_any_thread_count() {
+    let s = Scene::physical("rated").unwrap();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut l = Ltca::new(&s).unwrap();
+            (l.twist_loop(rated(), 0.0, 40).unwrap(), l.evaluations())
+        })
+    };
+    let (one, e1) = run(1);
+    let (two, e2) = run(2);
+    assert_eq!(one, two);
+    assert_eq!(e1, e2);
+    let none = friction::FrictionLaws::none(&s);
+    let in_order = Ltca::new(&s)
+        .unwrap()
+        .twist_loop_with_friction(&none, rated(), 0.0, 40)
+        .unwrap();
+    for (a, b) in one.twist.iter().zip(&in_order.twist) {
+        assert!((a - b).abs() < 1e-12, "{a} {b}");
+    }
+}
