@@ -874,6 +874,15 @@ fn report_hertz_strips_equal_the_checked_hertz_contact() {
     }
 }
 
+/// `f` run in a rayon pool of `threads` threads.
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
 /// A sweep of `2 SWEEP_CHAIN` angles runs as two chains in parallel (the second from the
 /// kinematic pose): the same bits on one thread as on two, and the same equilibria as one
 /// unbroken chain of single solves to the Newton tolerance. Tolerances: forces 1e-9 of the
@@ -891,11 +900,7 @@ fn parallel_chains_equal_one_unbroken_sweep() {
     let period = Ltca::new(&s).unwrap().mesh_period();
     let angles: Vec<f64> = (0..n).map(|i| period * i as f64 / n as f64).collect();
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             let mut l = Ltca::new(&s).unwrap();
             let pts = l.sweep(rated(), &angles).unwrap();
             (pts, l.evaluations(), l.last_unknowns().to_vec())
@@ -975,11 +980,7 @@ fn a_chain_that_fails_from_the_kinematic_pose_continues_the_one_before() {
 fn the_two_chain_loop_is_the_same_on_any_thread_count() {
     let s = Scene::physical("rated").unwrap();
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             let mut l = Ltca::new(&s).unwrap();
             (l.twist_loop(rated(), 0.0, 40).unwrap(), l.evaluations())
         })
