@@ -185,6 +185,15 @@ impl LocalFoot {
     }
 }
 
+/// A foot, or a pin shown to be farther from the curve than asked
+/// ([`CycloidGeometry::contact_foot_or_open`]), with the lower bound of its signed distance
+/// [m] that showed it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum FootOrOpen {
+    Foot(LocalFoot),
+    Open(f64),
+}
+
 /// A root of `g` (value, derivative) in the bracket `[a, b]` where `g` changes sign: Newton
 /// steps while they stay inside the shrinking bracket and at least halve the previous step,
 /// bisection otherwise (the safeguard of Press et al., Numerical Recipes, 3rd ed., 2007,
@@ -362,13 +371,27 @@ impl CycloidGeometry {
     }
 
     /// As [`CycloidGeometry::foot_with_fallback_cs`] for a caller that uses neither `d1` nor
-    /// `d2` of the foot (the models' pin queries): `d2` is not moved to the foot and is NaN.
-    /// Everything else is the same, bit for bit.
+    /// `d2` of the foot (the models' pin queries): `d2` is not moved to the foot and is NaN;
+    /// everything else is the same, bit for bit. Or [`FootOrOpen::Open`] when `probe = (dist,
+    /// open_above)` shows at the seed that the signed distance of `p` from `C` exceeds
+    /// `open_above`: the seed point `C(seed)` and its outward normal `n` give the point
+    /// `r = C(seed) + dist n`, exactly `dist` from `C` while `0 <= dist <` the ambiguity
+    /// distance (half the smallest concave radius of curvature: `r` is within the curve's
+    /// reach on its outer side, so its nearest point is `C(seed)`), and the signed distance is
+    /// 1-Lipschitz, so it is at least `dist - |p - r|` at `p` (less the round-off of a seed
+    /// `(cos, sin)` that is not exactly of unit length); `Open` carries that bound. The test costs a few operations on
+    /// top of the first iteration's curve evaluation, which the search needs anyway.
     #[inline]
-    pub(crate) fn contact_foot(&self, p: [f64; 2], seed: f64, cs: [f64; 2]) -> Option<LocalFoot> {
-        match self.foot_iterate::<false>(p, seed, cs) {
+    pub(crate) fn contact_foot_or_open(
+        &self,
+        p: [f64; 2],
+        seed: f64,
+        cs: [f64; 2],
+        probe: Option<(f64, f64)>,
+    ) -> Option<FootOrOpen> {
+        match self.foot_iterate::<false>(p, seed, cs, probe) {
             Some(f) => Some(f),
-            None => self.foot(p, self.seed.seed(self, p)?),
+            None => self.foot(p, self.seed.seed(self, p)?).map(FootOrOpen::Foot),
         }
     }
 
@@ -398,7 +421,10 @@ impl CycloidGeometry {
     /// the nearer foot. `None` if no foot is found.
     #[inline]
     pub(crate) fn foot_cs(&self, p: [f64; 2], seed: f64, seed_cs: [f64; 2]) -> Option<LocalFoot> {
-        self.foot_iterate::<true>(p, seed, seed_cs)
+        match self.foot_iterate::<true>(p, seed, seed_cs, None)? {
+            FootOrOpen::Foot(f) => Some(f),
+            FootOrOpen::Open(_) => None,
+        }
     }
 
     /// [`CycloidGeometry::foot_cs`]; without `D2` the foot's `d2` is NaN (not moved to it).
@@ -408,18 +434,35 @@ impl CycloidGeometry {
         p: [f64; 2],
         seed: f64,
         seed_cs: [f64; 2],
-    ) -> Option<LocalFoot> {
+        probe: Option<(f64, f64)>,
+    ) -> Option<FootOrOpen> {
         let k = &self.seed.curve;
         let zp = f64::from(k.zp);
         let max_step = PI / (2.0 * zp);
         let mut phi = seed;
         let mut u = seed_cs;
         let mut v = cpow(u, k.zp);
+        if let Some((dist, open_above)) = probe
+            && dist >= 0.0
+            && dist < k.ambiguity_distance
+        {
+            let d = Derivs::new(k, u, v);
+            let inv_len = 1.0 / dot(d.d1, d.d1).sqrt();
+            let n = [d.d1[1] * inv_len, -d.d1[0] * inv_len];
+            let (dx, dy) = (p[0] - d.c[0] - dist * n[0], p[1] - d.c[1] - dist * n[1]);
+            // C(u) = R u - e u^zp is off the curve by about (R + zp e) |1 - |u|^2| when u is
+            // not of unit length.
+            let off = (k.r + k.ez[1]) * (1.0 - dot(u, u)).abs();
+            let lower = dist - (dx * dx + dy * dy).sqrt() - off;
+            if lower > open_above {
+                return Some(FootOrOpen::Open(lower));
+            }
+        }
         for it in 1..=MAX_NEWTON {
             let d = Derivs::new(k, u, v);
             let ([h1, h2, h3, h4], g) = d.distance_derivatives(p);
             if h2.is_nan() || h2 <= 0.0 {
-                return self.foot_near_root(p);
+                return self.foot_near_root(p).map(FootOrOpen::Foot);
             }
             // Halley's step -h1 / (h2 (1 + n q)), n = -h1 / h2 the Newton step and
             // q = h3 / (2 h2), written with one division: -h1 h2 / (h2^2 - h1 h3 / 2); it is
@@ -461,9 +504,9 @@ impl CycloidGeometry {
                     && let Some(other) = self.foot_near_root(p)
                     && other.dist < foot.dist
                 {
-                    return Some(other);
+                    return Some(FootOrOpen::Foot(other));
                 }
-                return Some(foot);
+                return Some(FootOrOpen::Foot(foot));
             }
             v = turn(v, zp * step, || cpow(u, k.zp));
         }
@@ -920,6 +963,53 @@ mod shift_tests {
                 }
             }
             assert!(worst < 1e-14, "d_rp {d_rp}: worst {worst:e} m");
+        }
+    }
+
+    /// The open test of `contact_foot_or_open`: whenever it answers `Open(lower)`, the exact
+    /// signed distance (the converged foot, itself checked against brute force above) is at
+    /// least `lower` and above the threshold asked. Points scattered around `r = C(phi) +
+    /// dist n` (the carried point of the last query) by up to 20 um, seeds up to 1e-4 rad from
+    /// `phi`, thresholds across the range: both answers occur.
+    #[test]
+    fn the_open_test_never_opens_a_closer_pin() {
+        let mut rnd = rnd_stream(23);
+        for d_rp in [0.0, -8e-4] {
+            let mut params = paper_params();
+            params.d_rp = d_rp;
+            let g = CycloidGeometry::new(params).unwrap();
+            let amb = g.seed.curve.ambiguity_distance;
+            let (mut opened, mut queried) = (0, 0);
+            for _ in 0..4000 {
+                let phi = 2.0 * PI * rnd();
+                let j = g.jet(phi);
+                let n = CycloidGeometry::normal_from_tangent(j.d1);
+                let dist = amb * 0.999 * rnd();
+                let (a, rad) = (2.0 * PI * rnd(), 2e-5 * rnd());
+                let p = [
+                    j.c[0] + dist * n[0] + rad * a.cos(),
+                    j.c[1] + dist * n[1] + rad * a.sin(),
+                ];
+                let seed = phi + 2e-4 * (rnd() - 0.5);
+                let cs = [seed.cos(), seed.sin()];
+                let open_above = dist * (rnd() - 0.2);
+                let exact = g.foot(p, phi).unwrap().dist;
+                match g.contact_foot_or_open(p, seed, cs, Some((dist, open_above))) {
+                    Some(FootOrOpen::Open(lower)) => {
+                        opened += 1;
+                        assert!(
+                            lower > open_above && exact >= lower - 1e-15,
+                            "{exact} {lower}"
+                        );
+                    }
+                    Some(FootOrOpen::Foot(f)) => {
+                        queried += 1;
+                        assert!((f.dist - exact).abs() < 1e-13, "{} {exact}", f.dist);
+                    }
+                    None => panic!("no foot"),
+                }
+            }
+            assert!(opened > 500 && queried > 500, "{opened} {queried}");
         }
     }
 

@@ -4,7 +4,7 @@
 use crate::contact::law::{LawForce, PinLaw, PinSite};
 use crate::dynamics::model::parts::{DiscModel, PinModel};
 use crate::error::{Result, RvdynError};
-use crate::geometry::gap::small_sin_cos;
+use crate::geometry::gap::{FootOrOpen, small_sin_cos};
 use std::cell::Cell;
 
 /// Where a disc is: centre [m], angle [rad] and the angle's sine and cosine (computed once per
@@ -161,7 +161,7 @@ impl PinContact {
 /// kinematic parameter; the parry polyline is the fallback seed. The answer does not depend on
 /// the seed (Newton converges to 1e-13 m on the exact curve): the warm start only saves
 /// iterations. `warm` is updated.
-#[inline(always)]
+#[cfg(test)]
 pub(crate) fn pin_query(
     disc: &DiscModel,
     pin: &PinModel,
@@ -170,6 +170,39 @@ pub(crate) fn pin_query(
     labels: (usize, usize),
     warm: &Cell<WarmStart>,
 ) -> Result<PinContact> {
+    match pin_query_or_open(disc, pin, pose, t, labels, warm, false)? {
+        PinQuery::Contact(c) => Ok(c),
+        PinQuery::Open(_) => Err(RvdynError::Simulation(
+            "a pin query without the open test found the pin open".into(),
+        )),
+    }
+}
+
+/// What [`pin_query_or_open`] found: the exact contact, or a pin shown open with a lower
+/// bound of its gap [m].
+pub(crate) enum PinQuery {
+    Contact(PinContact),
+    Open(f64),
+}
+
+/// [`pin_query`], or [`PinQuery::Open`] with a lower bound of the gap when `open_test` is set
+/// and the pin is shown open at the seed, from its last exact gap carried along the disc's rotation
+/// ([`CycloidGeometry::contact_foot_or_open`]: the seed is the last foot turned with the disc,
+/// and the pin keeps its place relative to a conjugate profile, so the test stays tight while
+/// the disc moves farther than the gap, where [`SeparationBound`] cannot skip). The warm start
+/// then moves to the seed and keeps its gap (a lower bound is all the test needs). Rigid
+/// profiles only: the caller sets `open_test` only without profile errors.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn pin_query_or_open(
+    disc: &DiscModel,
+    pin: &PinModel,
+    pose: &DiscPose,
+    t: f64,
+    labels: (usize, usize),
+    warm: &Cell<WarmStart>,
+    open_test: bool,
+) -> Result<PinQuery> {
     let g = &disc.geometry;
     let (centre, angle, s, c) = (pose.centre, pose.angle, pose.sin, pose.cos);
     let dp = [pin.centre[0] - centre[0], pin.centre[1] - centre[1]];
@@ -188,7 +221,26 @@ pub(crate) fn pin_query(
         let (s, c) = kinematic.sin_cos();
         (kinematic, [c, s])
     };
-    let foot = g.contact_foot(local, seed, cs).ok_or_else(|| {
+    let r_gen = g.generating_pin_radius();
+    // The last exact gap as a signed distance from the pin-centre curve, and the distance
+    // beyond which the pin is open (with a round-off allowance).
+    let probe = (open_test && w.gap > OPEN_SLACK && w.gap.is_finite())
+        .then_some((w.gap + pin.radius - r_gen, pin.radius - r_gen + OPEN_SLACK));
+    let found = g.contact_foot_or_open(local, seed, cs, probe);
+    if let Some(FootOrOpen::Open(lower)) = found {
+        warm.set(WarmStart {
+            phi: seed,
+            kinematic,
+            cos_sin: cs,
+            ..w
+        });
+        return Ok(PinQuery::Open(lower + r_gen - pin.radius - OPEN_SLACK));
+    }
+    let foot = found.and_then(|f| match f {
+        FootOrOpen::Foot(f) => Some(f),
+        FootOrOpen::Open(_) => None,
+    });
+    let foot = foot.ok_or_else(|| {
         // In a run this means the state is unphysical, so it is a simulation failure.
         RvdynError::Simulation(format!(
             "exact gap of pin {} on disc {} not found at t = {t:.6e} s: the disc is farther \
@@ -199,7 +251,6 @@ pub(crate) fn pin_query(
             labels.0
         ))
     })?;
-    let r_gen = g.generating_pin_radius();
     let mut gap = foot.dist + r_gen - pin.radius;
     // Profile error: the ground profile offset by delta(phi) along its normal shrinks the gap
     // by delta at the foot (first order); the foot moves with the disc, so the penetration's
@@ -235,14 +286,18 @@ pub(crate) fn pin_query(
         foot.centre_point[0] - r_gen * foot.normal[0],
         foot.centre_point[1] - r_gen * foot.normal[1],
     ]);
-    Ok(PinContact {
+    Ok(PinQuery::Contact(PinContact {
         penetration: -gap,
         normal: [c * nl[0] - s * nl[1], s * nl[0] + c * nl[1]],
         arm: [c * pl[0] - s * pl[1], s * pl[0] + c * pl[1]],
         phi: foot.phi,
         error_gradient,
-    })
+    }))
 }
+
+/// Round-off allowance of the open test of [`pin_query_or_open`] [m] (the seed's curve point
+/// and normal carry about 1e-16 of the pin circle radius).
+const OPEN_SLACK: f64 = 1e-12;
 
 /// The error raised when a penetration exceeds the physical bound.
 pub(crate) fn penetration_error(t: f64, pen: f64, bound: f64, what: &str) -> RvdynError {
@@ -308,14 +363,26 @@ pub(crate) fn touching_pin(
     {
         return Ok(None);
     }
-    let pc = pin_query(disc, pin, pose, t, labels, warm)?;
+    // The open test only where the pose-based bound is kept (rigid profiles); either answer
+    // renews that bound at this pose (a pin shown open with its gap's lower bound).
+    let (pc, gap) = match pin_query_or_open(disc, pin, pose, t, labels, warm, separation.is_some())?
+    {
+        PinQuery::Contact(pc) => {
+            let gap = -pc.penetration;
+            (Some(pc), gap)
+        }
+        PinQuery::Open(lower) => (None, lower),
+    };
     if let Some((bound, _)) = separation {
         bound.set(SeparationBound {
             centre: pose.centre,
             angle: pose.angle,
-            gap: -pc.penetration,
+            gap,
         });
     }
+    let Some(pc) = pc else {
+        return Ok(None);
+    };
     if pc.penetration <= 0.0 {
         return Ok(None);
     }
