@@ -1,6 +1,6 @@
 //! rvdyn: dynamics of RV cycloid planetary reducers.
 //!
-//! Pure-Rust core (no pyo3 outside [`python`], which is compiled only with the `python` feature).
+//! Pure-Rust core (no pyo3 outside `python`, which is compiled only with the `python` feature).
 //! Folders by concern:
 //! - [`geometry`]: exact cycloid profile and pin gap, involute first stage, mass properties;
 //! - [`bearing`]: roller bearings with clearance (Palmgren rollers), ISO 281 life, friction;

@@ -74,7 +74,7 @@ fn check_ratio(ratio: f64) -> Result<f64> {
     }
 }
 
-/// Distance [m] from the pitch point to the contact of the pin at mesh angle `phi` [rad]
+/// Distance \[m\] from the pitch point to the contact of the pin at mesh angle `phi` \[rad\]
 /// (from the eccentricity direction): `rp S - rrp`. The sliding speed is this times the disc's
 /// angular speed relative to the pins.
 pub fn pin_sliding_arm(params: &CycloidParams, phi: f64) -> f64 {
@@ -185,7 +185,7 @@ pub struct EfficiencyEstimate {
 }
 
 /// Efficiency estimate of an RV reducer with the cycloid `cycloid`, sun and planet teeth
-/// `z_sun`, `z_planet`, module [m] and pressure angle [rad] of the first stage, reducer ratio
+/// `z_sun`, `z_planet`, module \[m\] and pressure angle \[rad\] of the first stage, reducer ratio
 /// `ratio`, pin friction coefficient `mu_pin` with sliding lever ratio `pin_lever`, mesh
 /// friction coefficient `mu_mesh` (module documentation; closed-form pin term).
 ///

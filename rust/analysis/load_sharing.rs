@@ -10,9 +10,9 @@
 use crate::error::{Result, RvdynError, require_finite};
 use crate::geometry::CycloidGeometry;
 
-/// Classical pin forces [N], one per pin (index j = the paper's pin j + 1), for a disc that
+/// Classical pin forces \[N\], one per pin (index j = the paper's pin j + 1), for a disc that
 /// carries the torque `disc_torque` [N m] about its own centre when its centre is at crank
-/// angle `crank_angle` [rad] (`e (cos, sin)` of it). Forces are compressive (>= 0); a negative
+/// angle `crank_angle` \[rad\] (`e (cos, sin)` of it). Forces are compressive (>= 0); a negative
 /// torque loads the other half.
 ///
 /// Holds for the unmodified profile; modifications reduce the loaded pins (see the dynamic
@@ -56,8 +56,8 @@ pub fn classical_pin_forces(
         .collect())
 }
 
-/// Lever `l_j = rc' sin(phi_j) / S_j` [m] of each pin's contact normal about the disc centre
-/// for the disc centre at crank angle `crank_angle` [rad].
+/// Lever `l_j = rc' sin(phi_j) / S_j` \[m\] of each pin's contact normal about the disc centre
+/// for the disc centre at crank angle `crank_angle` \[rad\].
 pub fn classical_levers(geometry: &CycloidGeometry, crank_angle: f64) -> Vec<f64> {
     let k1 = geometry.k1();
     let rc = geometry.pitch_radius();

@@ -41,7 +41,7 @@ pub struct ExcitationOrder {
 }
 
 impl ExcitationOrder {
-    /// Frequency [Hz] of this order at the input speed `input_speed` [rad/s] (its magnitude).
+    /// Frequency \[Hz\] of this order at the input speed `input_speed` [rad/s] (its magnitude).
     pub fn frequency(&self, input_speed: f64) -> f64 {
         self.order * input_speed.abs() / TAU
     }
@@ -126,7 +126,7 @@ pub fn scene_orders(scene: &Scene, harmonics: u32) -> Result<Vec<ExcitationOrder
 pub struct Crossing {
     /// Input speed [rad/s].
     pub speed: f64,
-    /// Frequency [Hz] (the mode's natural frequency at that speed = the order's frequency).
+    /// Frequency \[Hz\] (the mode's natural frequency at that speed = the order's frequency).
     pub frequency: f64,
     /// Index into the orders given.
     pub order: usize,
@@ -136,7 +136,7 @@ pub struct Crossing {
 
 /// Crossings of each order line `f = order omega / 2 pi` with each natural-frequency curve.
 ///
-/// `speeds` [rad/s]: at least 2, finite, > 0, strictly increasing. `frequencies[s][m]` [Hz]:
+/// `speeds` [rad/s]: at least 2, finite, > 0, strictly increasing. `frequencies[s][m]` \[Hz\]:
 /// the natural frequency of mode `m` at speed `s` (finite, >= 0, the same number of modes at
 /// every speed), linear between the speeds, so each crossing is the exact root on its
 /// interval. Sorted by speed, then order, then mode. A frequency that does not depend on the

@@ -28,19 +28,19 @@ use std::f64::consts::PI;
 /// Result of [`line_law_load_sharing`] (SI).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PinLoadSharing {
-    /// Disc rotation about its centre from its kinematic angle [rad].
+    /// Disc rotation about its centre from its kinematic angle \[rad\].
     pub beta: f64,
-    /// Force of each pin [N] (index j = the paper's pin j + 1).
+    /// Force of each pin \[N\] (index j = the paper's pin j + 1).
     pub forces: Vec<f64>,
-    /// Approach (penetration) of each pin [m] (0 where it does not touch).
+    /// Approach (penetration) of each pin \[m\] (0 where it does not touch).
     pub approaches: Vec<f64>,
-    /// Hertz peak pressure at each pin [Pa].
+    /// Hertz peak pressure at each pin \[Pa\].
     pub peak_pressures: Vec<f64>,
     /// Number of pins with a force.
     pub loaded: usize,
-    /// Largest pin force [N].
+    /// Largest pin force \[N\].
     pub max_force: f64,
-    /// Largest approach [m].
+    /// Largest approach \[m\].
     pub max_approach: f64,
     /// Residual of the moment balance [N m].
     pub moment_residual: f64,
@@ -54,8 +54,8 @@ struct Eval {
 }
 
 /// Quasi-static pin forces of the disc `geometry` carrying the moment `disc_torque` [N m]
-/// about its centre at the crank angle `crank_angle` [rad], rigid pins of radius
-/// `pin_radius` [m] on the pin circle, line-contact law with the materials `pin` and `disc`.
+/// about its centre at the crank angle `crank_angle` \[rad\], rigid pins of radius
+/// `pin_radius` \[m\] on the pin circle, line-contact law with the materials `pin` and `disc`.
 ///
 /// Errors: `Parameter` for non-finite inputs; `Convergence` if no bracket is found within a
 /// disc rotation of 0.05 rad (a torque far beyond any physical load); geometry errors from the
@@ -157,8 +157,8 @@ pub fn line_law_load_sharing(
     Ok(finish(beta, eval(beta)?))
 }
 
-/// Output (carrier) wind-up [rad] of an RV reducer with the sun held and rigid meshes, for the
-/// disc rotation `beta` [rad] from [`line_law_load_sharing`]:
+/// Output (carrier) wind-up \[rad\] of an RV reducer with the sun held and rigid meshes, for the
+/// disc rotation `beta` \[rad\] from [`line_law_load_sharing`]:
 /// `th_c = beta zc / (zp + z_sun / z_planet)` (module documentation). Without a first stage
 /// (cranks held) pass `z_sun = 0`: `th_c = beta zc / zp`.
 ///
@@ -275,13 +275,13 @@ pub struct PhysicsSummary {
     /// Pin law kind (`impact`, `palmgren`, `line`).
     pub pin_law: String,
     /// Classical peak pin force `4 T_c / (zp rc')` at rated load, `T_c` half the output
-    /// torque [N].
+    /// torque \[N\].
     pub peak_pin_force: f64,
-    /// Approach of the pin law at that force, at the classical peak-load pin [m].
+    /// Approach of the pin law at that force, at the classical peak-load pin \[m\].
     pub pin_approach: f64,
     /// Mesh law kind (`impact`, `palmgren`, `iso6336`).
     pub mesh_law: String,
-    /// Rated tooth force per planet mesh `T_in / (planets r_bs)` [N].
+    /// Rated tooth force per planet mesh `T_in / (planets r_bs)` \[N\].
     pub mesh_force: f64,
     /// Mean mesh stiffness [N/m]: ISO 6336 `c_gamma b`, or the secant stiffness of the IMPACT
     /// law at the rated mesh force.

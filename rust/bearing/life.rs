@@ -47,13 +47,13 @@ pub struct RollerBearingGeometry {
     pub rollers: u32,
     /// Rows `i`.
     pub rows: u32,
-    /// Roller diameter `D_we` [m].
+    /// Roller diameter `D_we` \[m\].
     pub roller_diameter: f64,
-    /// Effective roller length `L_we` [m].
+    /// Effective roller length `L_we` \[m\].
     pub roller_length: f64,
-    /// Pitch diameter of the roller set `D_pw` [m].
+    /// Pitch diameter of the roller set `D_pw` \[m\].
     pub pitch_diameter: f64,
-    /// Nominal contact angle `alpha` [rad] (0 for radial roller bearings).
+    /// Nominal contact angle `alpha` \[rad\] (0 for radial roller bearings).
     pub contact_angle: f64,
     /// Rating factor `b_m` [-] (see [`BM_ROLLER`]).
     pub rating_factor: f64,
@@ -95,7 +95,7 @@ impl RollerBearingGeometry {
         self.roller_diameter * self.contact_angle.cos() / self.pitch_diameter
     }
 
-    /// Basic dynamic radial load rating `C_r` [N] (ISO 281 with `f_c` from the
+    /// Basic dynamic radial load rating `C_r` \[N\] (ISO 281 with `f_c` from the
     /// Lundberg-Palmgren expression; module documentation).
     pub fn dynamic_load_rating(&self) -> Result<f64> {
         self.validate()?;
@@ -144,8 +144,8 @@ pub fn l10_roller(rating: f64, equivalent_load: f64) -> Result<f64> {
     Ok((rating / equivalent_load).powf(10.0 / 3.0))
 }
 
-/// Equivalent load [N] of a load history for roller-bearing life: `(sum w_k P_k^(10/3) /
-/// sum w_k)^(3/10)` over samples `loads` [N] with weights `revolutions` (the revolutions, or
+/// Equivalent load \[N\] of a load history for roller-bearing life: `(sum w_k P_k^(10/3) /
+/// sum w_k)^(3/10)` over samples `loads` \[N\] with weights `revolutions` (the revolutions, or
 /// the rotation angle, spent at each sample; any consistent unit).
 ///
 /// Errors (`Parameter`) for different lengths, an empty history, a negative or non-finite
@@ -182,7 +182,7 @@ pub struct PalmgrenFriction {
     pub f0: f64,
     /// Load factor `f1` [-].
     pub f1: f64,
-    /// Pitch diameter `d_m` [m].
+    /// Pitch diameter `d_m` \[m\].
     pub pitch_diameter: f64,
     /// Oil kinematic viscosity at operating temperature `nu` [m^2/s].
     pub viscosity: f64,
@@ -190,7 +190,7 @@ pub struct PalmgrenFriction {
 
 impl PalmgrenFriction {
     /// As [`PalmgrenFriction::torque`] without the checks (validated inputs, hot loops):
-    /// friction torque magnitude [N m] at `speed` [rad/s] and radial load `load` [N].
+    /// friction torque magnitude [N m] at `speed` [rad/s] and radial load `load` \[N\].
     #[inline]
     pub fn torque_unchecked(&self, speed: f64, load: f64) -> f64 {
         let dm = self.pitch_diameter * 1e3;
@@ -204,7 +204,7 @@ impl PalmgrenFriction {
     }
 
     /// Friction torque [N m] at the speed `speed` [rad/s] (sign ignored) and radial load
-    /// `load` [N]: `M0 + M1` of the module documentation, converted from N mm.
+    /// `load` \[N\]: `M0 + M1` of the module documentation, converted from N mm.
     ///
     /// Errors (`Parameter`) for negative factors, non-positive pitch diameter, negative
     /// viscosity or load, non-finite speed.

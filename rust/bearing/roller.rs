@@ -38,11 +38,11 @@ pub const ROLLER_EXPONENT: f64 = 10.0 / 9.0;
 #[derive(Debug, Clone, PartialEq)]
 pub struct RollerBearing {
     rollers: usize,
-    /// Effective roller length `l` [m].
+    /// Effective roller length `l` \[m\].
     roller_length: f64,
-    /// Radial clearance per side `g` [m].
+    /// Radial clearance per side `g` \[m\].
     clearance: f64,
-    /// `K_n` in SI: `Q [N] = k_si * delta[m]^(10/9)`.
+    /// `K_n` in SI: `Q \[N\] = k_si * delta[m]^(10/9)`.
     k_si: f64,
     /// Unit directions of the rollers for cage angle 0.
     dirs: Vec<[f64; 2]>,
@@ -51,32 +51,32 @@ pub struct RollerBearing {
 /// Force on the inner ring, its tangent stiffness and the roller loads at one displacement.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BearingState {
-    /// Force on the inner ring [N], `(F_x, F_y)`.
+    /// Force on the inner ring \[N\], `(F_x, F_y)`.
     pub force: [f64; 2],
     /// Tangent stiffness `K = -dF/du` [N/m], row-major `[[Kxx, Kxy], [Kyx, Kyy]]`.
     pub stiffness: [[f64; 2]; 2],
     /// Number of loaded rollers.
     pub loaded: usize,
-    /// Largest roller load `Q_max` [N].
+    /// Largest roller load `Q_max` \[N\].
     pub max_roller_load: f64,
 }
 
 /// Result of [`RollerBearing::damped_force`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct DampedBearingForce {
-    /// Force on the inner ring [N].
+    /// Force on the inner ring \[N\].
     pub force: [f64; 2],
-    /// Power dissipated by the roller dampers [W] (>= 0).
+    /// Power dissipated by the roller dampers \[W\] (>= 0).
     pub dissipation: f64,
-    /// Elastic energy of the rollers [J].
+    /// Elastic energy of the rollers \[J\].
     pub energy: f64,
-    /// Largest roller force [N].
+    /// Largest roller force \[N\].
     pub max_roller_load: f64,
 }
 
 impl RollerBearing {
-    /// Build a bearing of `rollers` rollers of effective length `roller_length` [m] with the
-    /// radial clearance per side `clearance` [m] (half the diametral clearance; 0 allowed).
+    /// Build a bearing of `rollers` rollers of effective length `roller_length` \[m\] with the
+    /// radial clearance per side `clearance` \[m\] (half the diametral clearance; 0 allowed).
     ///
     /// Errors (`Parameter`): zero rollers (or fewer than 3, which cannot hold a radial load in
     /// every direction), a non-positive or non-finite length, a negative or non-finite
@@ -115,12 +115,12 @@ impl RollerBearing {
         self.rollers
     }
 
-    /// Effective roller length [m].
+    /// Effective roller length \[m\].
     pub fn roller_length(&self) -> f64 {
         self.roller_length
     }
 
-    /// Radial clearance per side [m].
+    /// Radial clearance per side \[m\].
     pub fn clearance(&self) -> f64 {
         self.clearance
     }
@@ -130,7 +130,7 @@ impl RollerBearing {
         self.k_si
     }
 
-    /// Load `Q` [N] and slope `dQ/d delta` [N/m] of one roller compressed by `delta` [m]
+    /// Load `Q` \[N\] and slope `dQ/d delta` [N/m] of one roller compressed by `delta` \[m\]
     /// (0 and 0 for `delta <= 0`).
     #[inline]
     pub fn roller_load(&self, delta: f64) -> (f64, f64) {
@@ -142,8 +142,8 @@ impl RollerBearing {
         (q, ROLLER_EXPONENT * self.k_si * p)
     }
 
-    /// Force on the inner ring and tangent stiffness at the displacement `u` [m] of the inner
-    /// ring relative to the outer ring, with the cage (roller set) turned by `cage_angle` [rad].
+    /// Force on the inner ring and tangent stiffness at the displacement `u` \[m\] of the inner
+    /// ring relative to the outer ring, with the cage (roller set) turned by `cage_angle` \[rad\].
     ///
     /// A non-finite displacement gives zero force (callers check their state for NaN).
     pub fn state(&self, u: [f64; 2], cage_angle: f64) -> BearingState {
@@ -190,11 +190,11 @@ impl RollerBearing {
         st
     }
 
-    /// Force on the inner ring [N] with stiffness-proportional damping per roller, at the
-    /// displacement `u` [m] and its rate `u_rate` [m/s]: roller `j` pushes with
-    /// `max(0, Q_j + beta k_j n_j . u_rate)` (`k_j = dQ_j/d delta_j`, `beta` [s] >= 0), so no
-    /// roller pulls. Returns the force, the power dissipated by the dampers [W] (>= 0), the
-    /// elastic energy [J] and the largest roller force [N]. Roller set fixed (cage angle 0).
+    /// Force on the inner ring \[N\] with stiffness-proportional damping per roller, at the
+    /// displacement `u` \[m\] and its rate `u_rate` [m/s]: roller `j` pushes with
+    /// `max(0, Q_j + beta k_j n_j . u_rate)` (`k_j = dQ_j/d delta_j`, `beta` \[s\] >= 0), so no
+    /// roller pulls. Returns the force, the power dissipated by the dampers \[W\] (>= 0), the
+    /// elastic energy \[J\] and the largest roller force \[N\]. Roller set fixed (cage angle 0).
     pub fn damped_force(&self, u: [f64; 2], u_rate: [f64; 2], beta: f64) -> DampedBearingForce {
         let mut out = DampedBearingForce::default();
         let r2 = u[0] * u[0] + u[1] * u[1];
@@ -218,8 +218,8 @@ impl RollerBearing {
         out
     }
 
-    /// Elastic energy [J] stored in the rollers at the displacement `u` [m] and cage angle
-    /// `cage_angle` [rad]: `sum_j K_n delta_j^(19/9) / (19/9)` over the compressed rollers
+    /// Elastic energy \[J\] stored in the rollers at the displacement `u` \[m\] and cage angle
+    /// `cage_angle` \[rad\]: `sum_j K_n delta_j^(19/9) / (19/9)` over the compressed rollers
     /// (its gradient is `-force`).
     pub fn elastic_energy(&self, u: [f64; 2], cage_angle: f64) -> f64 {
         let r2 = u[0] * u[0] + u[1] * u[1];
@@ -241,7 +241,7 @@ impl RollerBearing {
             .sum()
     }
 
-    /// Radial load [N] along `x` at the radial displacement `delta_r` [m] along `x`, from
+    /// Radial load \[N\] along `x` at the radial displacement `delta_r` \[m\] along `x`, from
     /// Harris's many-roller integral for zero clearance: `Z K_n delta_r^(10/9) J_r(0.5)`.
     /// Valid for `clearance = 0`; independent of the cage angle only in the limit of many
     /// rollers. Errors (`Parameter`) for a negative or non-finite displacement.
@@ -250,7 +250,7 @@ impl RollerBearing {
         Ok(self.rollers as f64 * self.k_si * delta_r.powf(ROLLER_EXPONENT) * RADIAL_INTEGRAL_HALF)
     }
 
-    /// Radial stiffness [N/m] of Harris's closed form at the displacement `delta_r` [m]
+    /// Radial stiffness [N/m] of Harris's closed form at the displacement `delta_r` \[m\]
     /// (zero clearance): `(10/9) Z K_n delta_r^(1/9) J_r(0.5)`.
     pub fn harris_radial_stiffness(&self, delta_r: f64) -> Result<f64> {
         require_non_negative("radial displacement", delta_r, "m")?;

@@ -236,15 +236,15 @@ impl HysteresisDamping {
         self.chi_over_v * self.reference_speed
     }
 
-    /// Contact force [N] from the elastic force `elastic` [N] (>= 0; 0 without contact) and the
+    /// Contact force \[N\] from the elastic force `elastic` \[N\] (>= 0; 0 without contact) and the
     /// approach rate `rate` [m/s] (positive closing). Never negative.
     #[inline]
     pub fn force(&self, elastic: f64, rate: f64) -> f64 {
         (elastic * (1.0 + self.chi_over_v * rate)).max(0.0)
     }
 
-    /// Force [N] and its partial derivatives `dF/d delta` [N/m] and `dF/d delta_dot` [N s/m]
-    /// from the elastic force `elastic` [N], its tangent stiffness `stiffness` [N/m] and the
+    /// Force \[N\] and its partial derivatives `dF/d delta` [N/m] and `dF/d delta_dot` [N s/m]
+    /// from the elastic force `elastic` \[N\], its tangent stiffness `stiffness` [N/m] and the
     /// approach rate `rate` [m/s]. All three are 0 where the clamp is active.
     #[inline]
     pub fn force_and_derivatives(
@@ -264,7 +264,7 @@ impl HysteresisDamping {
 }
 
 /// Contact damping proportional to the tangent stiffness of the elastic law:
-/// `F = max(0, F_el(delta) + beta k_t(delta) delta_dot)` with `beta` [s].
+/// `F = max(0, F_el(delta) + beta k_t(delta) delta_dot)` with `beta` \[s\].
 ///
 /// If every spring of a linear(ised) model carries a damper `beta` times its stiffness, each
 /// mode `n` has the damping ratio `zeta_n = beta omega_n / 2` (stiffness-proportional Rayleigh
@@ -274,7 +274,7 @@ impl HysteresisDamping {
 /// never pulls (clamp).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StiffnessProportionalDamping {
-    /// `beta` [s].
+    /// `beta` \[s\].
     pub beta: f64,
 }
 
@@ -293,8 +293,8 @@ impl StiffnessProportionalDamping {
         })
     }
 
-    /// Force [N] and its derivatives `dF/d delta` [N/m], `dF/d delta_dot` [N s/m] from the
-    /// elastic force `elastic` [N], its tangent stiffness `stiffness` [N/m], its slope
+    /// Force \[N\] and its derivatives `dF/d delta` [N/m], `dF/d delta_dot` [N s/m] from the
+    /// elastic force `elastic` \[N\], its tangent stiffness `stiffness` [N/m], its slope
     /// `stiffness_slope = d k_t / d delta` [N/m^2] and the approach rate `rate` [m/s]; all 0
     /// where the clamp is active.
     #[inline]
@@ -324,7 +324,7 @@ mod tests {
     use crate::contact::Material;
     use crate::contact::line_contact::LineContactLaw;
 
-    /// Rebound speed ratio of a mass `m` [kg] hitting the damped contact at `v0` [m/s]:
+    /// Rebound speed ratio of a mass `m` \[kg\] hitting the damped contact at `v0` [m/s]:
     /// classical RK4 on (delta, v) with a step of `period / n_steps` and the exit time found by
     /// linear interpolation of `delta` across the last step.
     fn impact_restitution(

@@ -1,7 +1,7 @@
 //! Regularised Coulomb friction (optionally with a Stribeck drop) for smooth integrators.
 //!
 //! Tangential force on a body whose contact point slides at `v` [m/s] relative to the other
-//! body, under the normal force `N >= 0` [N]:
+//! body, under the normal force `N >= 0` \[N\]:
 //!
 //! `F_t = -mu(|v|) N tanh(v / v_reg)`
 //!
@@ -85,8 +85,8 @@ impl CoulombFriction {
         }
     }
 
-    /// Tangential force [N] on the body whose contact point slides at `v` [m/s], under the
-    /// normal force `normal` [N] (negative normal forces count as 0), and its derivative
+    /// Tangential force \[N\] on the body whose contact point slides at `v` [m/s], under the
+    /// normal force `normal` \[N\] (negative normal forces count as 0), and its derivative
     /// `dF_t/dv` [N s/m] (<= 0 without Stribeck).
     #[inline]
     pub fn force_and_slope(&self, v: f64, normal: f64) -> (f64, f64) {
@@ -109,14 +109,14 @@ impl CoulombFriction {
         (f, slope)
     }
 
-    /// Tangential force [N] only (see [`CoulombFriction::force_and_slope`]).
+    /// Tangential force \[N\] only (see [`CoulombFriction::force_and_slope`]).
     #[inline]
     pub fn force(&self, v: f64, normal: f64) -> f64 {
         self.force_and_slope(v, normal).0
     }
 
-    /// Dissipated power `-F_t v` [W] (>= 0) at the sliding speed `v` [m/s] and normal force
-    /// `normal` [N].
+    /// Dissipated power `-F_t v` \[W\] (>= 0) at the sliding speed `v` [m/s] and normal force
+    /// `normal` \[N\].
     #[inline]
     pub fn power(&self, v: f64, normal: f64) -> f64 {
         -self.force(v, normal) * v
@@ -126,11 +126,11 @@ impl CoulombFriction {
 /// Geometry of the path of contact of an external spur pair for tooth friction (SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ToothPath {
-    /// Distance between the base-circle tangency points `T1 T2` [m], `(r_b1 + r_b2) tan a`.
+    /// Distance between the base-circle tangency points `T1 T2` \[m\], `(r_b1 + r_b2) tan a`.
     pub t1t2: f64,
-    /// Distance from `T1` to the start of contact `A` [m], `T1T2 - sqrt(ra2^2 - rb2^2)`.
+    /// Distance from `T1` to the start of contact `A` \[m\], `T1T2 - sqrt(ra2^2 - rb2^2)`.
     pub t1a: f64,
-    /// Base pitch [m].
+    /// Base pitch \[m\].
     pub base_pitch: f64,
     /// Fractional part of the transverse contact ratio (double-contact share of a pitch).
     pub double_fraction: f64,
@@ -138,7 +138,7 @@ pub struct ToothPath {
 
 impl ToothPath {
     /// Path of a standard spur pair (no shift, standard centre distance) of base radii
-    /// `rb1`, `rb2` [m], tip radius of gear 2 `ra2` [m], pressure angle [rad], base pitch [m]
+    /// `rb1`, `rb2` \[m\], tip radius of gear 2 `ra2` \[m\], pressure angle \[rad\], base pitch \[m\]
     /// and contact ratio [-].
     pub fn new(
         rb1: f64,
@@ -158,8 +158,8 @@ impl ToothPath {
     }
 
     /// Friction torques [N m] on gear 1 and gear 2 (about their own axes, in the carrier
-    /// frame) and the friction power [W] (>= 0) for the total normal force `normal` [N] of the
-    /// mesh at the mesh position `s` [m] (position of the newest pair along the path from `A`,
+    /// frame) and the friction power \[W\] (>= 0) for the total normal force `normal` \[N\] of the
+    /// mesh at the mesh position `s` \[m\] (position of the newest pair along the path from `A`,
     /// modulo the base pitch), gear speeds `w1`, `w2` [rad/s] relative to the carrier, and the
     /// friction law `law`.
     ///

@@ -13,14 +13,14 @@ use std::f64::consts::PI;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
-    /// Young's modulus `E` [Pa].
+    /// Young's modulus `E` \[Pa\].
     pub youngs_modulus: f64,
     /// Poisson's ratio `nu` [-], in (-1, 0.5).
     pub poisson_ratio: f64,
 }
 
 impl Material {
-    /// Build a validated material from `E` [Pa] and `nu` [-].
+    /// Build a validated material from `E` \[Pa\] and `nu` [-].
     ///
     /// Errors (`RvdynError::Parameter`) unless `E > 0` and `-1 < nu < 0.5`, both finite.
     pub fn new(youngs_modulus: f64, poisson_ratio: f64) -> Result<Self> {
@@ -62,7 +62,7 @@ impl Material {
     }
 }
 
-/// Effective (contact) modulus `E*` [Pa] of two materials.
+/// Effective (contact) modulus `E*` \[Pa\] of two materials.
 ///
 /// Returns `E*` with `1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2`. The paper's eq. 8 subtracts the
 /// two terms (docs/model.md#erratum-1), which is zero for equal materials; the sum is Hertz's.
@@ -71,7 +71,7 @@ pub fn effective_modulus(m1: &Material, m2: &Material) -> f64 {
     1.0 / (m1.compliance() + m2.compliance())
 }
 
-/// Effective radius `R` [m] of two parallel cylinders, `1/R = 1/r1 + 1/r2`.
+/// Effective radius `R` \[m\] of two parallel cylinders, `1/R = 1/r1 + 1/r2`.
 ///
 /// Radii in m, positive convex, negative concave. Returns `R > 0`. Errors
 /// (`RvdynError::Geometry`) if a radius is zero or not finite, or if `R` is not positive: two
@@ -106,17 +106,17 @@ pub fn effective_radius(r1: f64, r2: f64) -> Result<f64> {
 /// Result of a Hertz line contact (SI units).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LineContact {
-    /// Half width `a` of the contact strip [m].
+    /// Half width `a` of the contact strip \[m\].
     pub half_width: f64,
-    /// Peak (central) pressure `p0` [Pa].
+    /// Peak (central) pressure `p0` \[Pa\].
     pub peak_pressure: f64,
-    /// Mean pressure `(pi/4) p0` [Pa].
+    /// Mean pressure `(pi/4) p0` \[Pa\].
     pub mean_pressure: f64,
-    /// Approach of the two cylinder axes (sum of both bodies' centre-to-contact deflections) [m].
+    /// Approach of the two cylinder axes (sum of both bodies' centre-to-contact deflections) \[m\].
     pub approach: f64,
 }
 
-/// Hertz contact of two parallel cylinders pressed together by `force` [N] over `length` [m].
+/// Hertz contact of two parallel cylinders pressed together by `force` \[N\] over `length` \[m\].
 ///
 /// Radii `r1`, `r2` in m (positive convex, negative concave). Returns, with `P = F/L` and
 /// `R`, `E*` from [`effective_radius`] and [`effective_modulus`]:
@@ -186,9 +186,9 @@ pub fn hertz_line_contact(
     Ok(c)
 }
 
-/// Half-width `a` [m] and peak pressure `p0` [Pa] of the Hertz line contact under the line
-/// load `p` [N/m] (`p >= 0`), effective radius `r` [m] (`> 0`) and effective modulus `e_star`
-/// [Pa] (`> 0`): `a = sqrt(p) sqrt(4 r / (pi E*))`, `p0 = sqrt(p) sqrt(E* / (pi r))`
+/// Half-width `a` \[m\] and peak pressure `p0` \[Pa\] of the Hertz line contact under the line
+/// load `p` [N/m] (`p >= 0`), effective radius `r` \[m\] (`> 0`) and effective modulus `e_star`
+/// \[Pa\] (`> 0`): `a = sqrt(p) sqrt(4 r / (pi E*))`, `p0 = sqrt(p) sqrt(E* / (pi r))`
 /// (`= 2 p / (pi a)`), the strip of [`hertz_line_contact`] without its checks or the approach
 /// (for inputs checked once, as the LTCA's report does per loaded pin).
 ///
@@ -211,7 +211,7 @@ pub fn hertz_line_strip(p: f64, r: f64, e_star: f64) -> (f64, f64) {
 /// Palmgren's coefficient 3.84e-5 mm N^-0.9 mm^0.8 (steel roller against raceway).
 const PALMGREN_COEFF_MM: f64 = 3.84e-5;
 
-/// Palmgren's approach [m] of a steel line contact under `force` [N] over `length` [m].
+/// Palmgren's approach \[m\] of a steel line contact under `force` \[N\] over `length` \[m\].
 ///
 /// Returns `delta = 3.84e-5 Q^0.9 / l^0.8` evaluated in mm with `Q` in N and `l` in mm
 /// (T. A. Harris, Rolling Bearing Analysis), converted to m. Empirical for steel on steel;
@@ -224,7 +224,7 @@ pub fn palmgren_approach(force: f64, length: f64) -> Result<f64> {
     Ok(PALMGREN_COEFF_MM * force.powf(0.9) / l_mm.powf(0.8) * 1e-3)
 }
 
-/// Palmgren tangent stiffness `dQ/d delta` [N/m] at `force` [N] over `length` [m].
+/// Palmgren tangent stiffness `dQ/d delta` [N/m] at `force` \[N\] over `length` \[m\].
 ///
 /// Returns `Q / (0.9 delta)` = `Q^0.1 l^0.8 / (0.9 * 3.84e-5)` (mm units, converted), which is
 /// 0 at zero force. Errors as [`palmgren_approach`].

@@ -47,13 +47,13 @@ pub struct ImpactLaw {
     pub exponent: f64,
     /// Damping coefficient `cmax` reached at full damping depth [N s/m].
     pub max_damping: f64,
-    /// Penetration `d` at which the damping reaches `cmax` [m].
+    /// Penetration `d` at which the damping reaches `cmax` \[m\].
     pub damping_depth: f64,
 }
 
 impl ImpactLaw {
     /// Build a validated law from stiffness [N/m^exponent], exponent [-], maximum damping
-    /// [N s/m] and damping depth [m].
+    /// [N s/m] and damping depth \[m\].
     ///
     /// Errors (`RvdynError::Parameter`) if any value is not finite, stiffness <= 0,
     /// exponent < 1, max_damping < 0 or damping_depth <= 0.
@@ -128,7 +128,7 @@ impl ImpactLaw {
         }
     }
 
-    /// Contact force [N] for a penetration [m] and penetration rate [m/s] (positive = closing).
+    /// Contact force \[N\] for a penetration \[m\] and penetration rate [m/s] (positive = closing).
     ///
     /// Returns 0 for `penetration <= 0`, otherwise `k x^e + STEP(x, 0, 0, d, cmax) xdot`
     /// clamped at 0: a contact can push, never pull, even when it separates fast.
@@ -161,7 +161,7 @@ impl ImpactLaw {
         }
     }
 
-    /// Elastic part of the force, `k x^e` [N] (0 without penetration).
+    /// Elastic part of the force, `k x^e` \[N\] (0 without penetration).
     #[inline]
     pub fn elastic_force(&self, penetration: f64) -> f64 {
         if penetration <= 0.0 {
@@ -171,7 +171,7 @@ impl ImpactLaw {
         }
     }
 
-    /// Elastic energy stored at a penetration, `k x^(e+1) / (e+1)` [J].
+    /// Elastic energy stored at a penetration, `k x^(e+1) / (e+1)` \[J\].
     #[inline]
     pub fn elastic_energy(&self, penetration: f64) -> f64 {
         if penetration <= 0.0 {
@@ -181,7 +181,7 @@ impl ImpactLaw {
         }
     }
 
-    /// Force [N] and its partial derivatives dF/dx [N/m] and dF/dxdot [N s/m], for implicit
+    /// Force \[N\] and its partial derivatives dF/dx [N/m] and dF/dxdot [N s/m], for implicit
     /// integrators.
     ///
     /// Returns `(f, df_dx, df_dxdot)`; all three are 0 where the force is 0 (no contact, or

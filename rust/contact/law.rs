@@ -30,11 +30,11 @@ pub enum DampingSpec {
         reference_speed: f64,
     },
     /// Stiffness-proportional: `F = F_el + beta k_t rate`, `beta = 2 ratio / (2 pi frequency)`:
-    /// the damping ratio `ratio` [-] of a linearised mode at `frequency` [Hz].
+    /// the damping ratio `ratio` [-] of a linearised mode at `frequency` \[Hz\].
     DampingRatio {
         /// Damping ratio [-], in [0, 1).
         ratio: f64,
-        /// Reference frequency [Hz].
+        /// Reference frequency \[Hz\].
         frequency: f64,
     },
 }
@@ -72,7 +72,7 @@ impl ContactDamping {
         }
     }
 
-    /// Total force [N] (>= 0) from the elastic force `elastic` [N], its tangent stiffness
+    /// Total force \[N\] (>= 0) from the elastic force `elastic` \[N\], its tangent stiffness
     /// `stiffness` [N/m] and the approach rate `rate` [m/s] (positive closing).
     #[inline]
     pub fn force(&self, elastic: f64, stiffness: f64, rate: f64) -> f64 {
@@ -85,7 +85,7 @@ impl ContactDamping {
 
 impl ContactDamping {
     /// Damping coefficient `dF/d(rate)` [N s/m] at zero rate for the elastic force `elastic`
-    /// [N] and its tangent stiffness `stiffness` [N/m] (0 without contact): the contact's part
+    /// \[N\] and its tangent stiffness `stiffness` [N/m] (0 without contact): the contact's part
     /// of a linearised damping matrix.
     #[inline]
     pub fn rate_coefficient(&self, elastic: f64, stiffness: f64) -> f64 {
@@ -109,11 +109,11 @@ pub fn default_poisson_ratio() -> f64 {
 /// A force and its elastic part, plus the stored energy when asked for.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct LawForce {
-    /// Total force [N] (>= 0).
+    /// Total force \[N\] (>= 0).
     pub force: f64,
-    /// Elastic force [N].
+    /// Elastic force \[N\].
     pub elastic: f64,
-    /// Elastic energy [J] (0 unless asked for).
+    /// Elastic energy \[J\] (0 unless asked for).
     pub energy: f64,
 }
 
@@ -122,11 +122,11 @@ pub struct LawForce {
 pub struct PinSite<'a> {
     /// The disc.
     pub geometry: &'a CycloidGeometry,
-    /// Curve parameter of the contact [rad].
+    /// Curve parameter of the contact \[rad\].
     pub phi: f64,
-    /// Pin radius [m].
+    /// Pin radius \[m\].
     pub pin_radius: f64,
-    /// The disc's body depth [m] (the cap of its reference depth; the models use the pin
+    /// The disc's body depth \[m\] (the cap of its reference depth; the models use the pin
     /// circle radius minus the pin radius, a constant, so that the law's energy depends on the
     /// state only through the approach and the contact's curve parameter).
     pub depth: f64,
@@ -149,7 +149,7 @@ pub enum PinLaw {
 }
 
 impl PinLaw {
-    /// Force at the approach `pen` [m] (> 0) and rate `rate` [m/s] at the contact `site`.
+    /// Force at the approach `pen` \[m\] (> 0) and rate `rate` [m/s] at the contact `site`.
     ///
     /// Errors (`Geometry`) only if the local geometry cannot make a line contact (an undercut
     /// or conformal profile, rejected by the scene check before a run).
@@ -245,8 +245,8 @@ impl PinLaw {
     /// moves with the pin's position `p` in the disc frame by `dphi/dp = C' / (|C'|^2 +
     /// (C - p).C'')` (the foot condition `(C - p).C' = 0`).
     ///
-    /// `elastic` [N] is the elastic force of this contact, `pin_centre`, `disc_centre` [m] and
-    /// `disc_angle` [rad] the pose. `None` for IMPACT (no location dependence). The `dU/dK0`
+    /// `elastic` \[N\] is the elastic force of this contact, `pin_centre`, `disc_centre` \[m\] and
+    /// `disc_angle` \[rad\] the pose. `None` for IMPACT (no location dependence). The `dU/dK0`
     /// formula holds below the line law's validity limit (about 240 times the rated pin force).
     pub fn location_slope(
         &self,
@@ -338,7 +338,7 @@ pub struct LocationSlope {
 }
 
 impl LocationSlope {
-    /// The generalised force of the location term on the disc centre [N] and angle [N m]:
+    /// The generalised force of the location term on the disc centre \[N\] and angle [N m]:
     /// `-dU/dphi * dphi/dq`.
     #[inline]
     pub fn forces(&self) -> ([f64; 2], f64) {
@@ -361,7 +361,7 @@ pub struct IsoMesh {
 
 impl IsoMesh {
     /// The ISO 6336-1 method B mesh of a solid, unshifted spur pair (standard rack) with
-    /// `z_sun`, `z_planet` teeth, module [m], pressure angle [rad], face width [m], the stiffness
+    /// `z_sun`, `z_planet` teeth, module \[m\], pressure angle \[rad\], face width \[m\], the stiffness
     /// ramps `ramp` (fraction of a base pitch) and the damping.
     ///
     /// Errors as [`IsoGearPair::validate`], [`MeshStiffnessWave::new`], [`ContactDamping::new`].
@@ -384,7 +384,7 @@ impl IsoMesh {
         })
     }
 
-    /// Force at the approach `pen` [m] (> 0), rate `rate` [m/s] and mesh position `s` [m]
+    /// Force at the approach `pen` \[m\] (> 0), rate `rate` [m/s] and mesh position `s` \[m\]
     /// along the line of action, with the slope `dk/ds` [N/m^2] for the energy-consistent
     /// generalised force (`V = k(s) pen^2 / 2`, so `dV/ds = k'(s) pen^2 / 2`).
     #[inline]
@@ -420,7 +420,7 @@ impl MeshLaw {
         }
     }
 
-    /// Force at the approach `pen` [m] (> 0), rate `rate` [m/s] and mesh position `s` [m],
+    /// Force at the approach `pen` \[m\] (> 0), rate `rate` [m/s] and mesh position `s` \[m\],
     /// with the stiffness slope `dk/ds` [N/m^2] (0 for IMPACT, which does not vary with `s`).
     #[inline]
     pub fn evaluate(&self, pen: f64, rate: f64, s: f64, want_energy: bool) -> (LawForce, f64) {
@@ -442,7 +442,7 @@ impl MeshLaw {
     }
 
     /// Mean stiffness [N/m] for reports: ISO's `c_gamma b`, or the IMPACT secant stiffness at
-    /// the approach `pen` [m].
+    /// the approach `pen` \[m\].
     pub fn mean_stiffness(&self, pen: f64) -> f64 {
         match self {
             MeshLaw::Impact(l) => {

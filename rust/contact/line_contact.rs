@@ -44,11 +44,11 @@ use std::f64::consts::PI;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LineContactLaw {
     length: f64,
-    /// Effective radius `R` [m].
+    /// Effective radius `R` \[m\].
     radius: f64,
-    /// Effective modulus `E*` [Pa].
+    /// Effective modulus `E*` \[Pa\].
     e_star: f64,
-    /// Reference depths `h_1`, `h_2` [m].
+    /// Reference depths `h_1`, `h_2` \[m\].
     depths: [f64; 2],
     /// Plane-strain compliances `(1 - nu_k^2)/E_k` [1/Pa].
     compliances: [f64; 2],
@@ -57,7 +57,7 @@ pub struct LineContactLaw {
     k1: f64,
     /// `a = alpha sqrt(F)` [m/sqrt(N)].
     alpha: f64,
-    /// Start of the linear extension: force [N], approach [m], compliance d delta/dF [m/N].
+    /// Start of the linear extension: force \[N\], approach \[m\], compliance d delta/dF [m/N].
     f_lim: f64,
     /// `ln f_lim` (kept: the inversion's bound).
     x_lim: f64,
@@ -66,9 +66,9 @@ pub struct LineContactLaw {
 }
 
 impl LineContactLaw {
-    /// Build the law from the contact length [m], the signed curvatures of the two surfaces at
+    /// Build the law from the contact length \[m\], the signed curvatures of the two surfaces at
     /// the contact [1/m] (positive convex, negative concave, 0 flat), the reference depths of
-    /// the two bodies [m] and their materials.
+    /// the two bodies \[m\] and their materials.
     ///
     /// Errors: `Parameter` for a non-positive or non-finite length or depth, a non-finite
     /// curvature, an invalid material; `Geometry` if `kappa_1 + kappa_2 <= 0` (concave-concave,
@@ -150,7 +150,7 @@ impl LineContactLaw {
         )
     }
 
-    /// The law from its coefficients `[K0, K1, alpha]` and validity limit `f_lim` [N] with
+    /// The law from its coefficients `[K0, K1, alpha]` and validity limit `f_lim` \[N\] with
     /// `x_lim = ln f_lim`: the approach and compliance at the limit, and an error (never a
     /// NaN) for coefficients beyond floating-point range. With `a <= h/2` every log term is
     /// `>= ln 8 > 1`, so this cannot fail for finite input.
@@ -190,13 +190,13 @@ impl LineContactLaw {
         })
     }
 
-    /// The law of a pin of radius `pin_radius` [m] against a disc profile of signed curvature
+    /// The law of a pin of radius `pin_radius` \[m\] against a disc profile of signed curvature
     /// `profile_curvature` [1/m] (positive convex, negative concave), face width
-    /// `face_width` [m].
+    /// `face_width` \[m\].
     ///
     /// Reference depths: the pin radius for the pin (a solid cylinder, Johnson's case); for the
     /// disc, where the profile is convex, its local radius of curvature `1/kappa` (the
-    /// "cylinder of the actual radius at the contact"), capped at `disc_depth` [m], a body
+    /// "cylinder of the actual radius at the contact"), capped at `disc_depth` \[m\], a body
     /// dimension (e.g. the distance from the disc centre to the contact): near a profile
     /// inflection the radius of curvature is unbounded, while the disc is not. Where the
     /// profile is concave or flat there is no solid cylinder on the disc side: the seat is
@@ -232,9 +232,9 @@ impl LineContactLaw {
         )
     }
 
-    /// The law of a pin of radius `pin_radius` [m] touching the disc `geometry` at the curve
-    /// parameter `phi` [rad] (the foot of an exact gap query), with the disc body depth
-    /// `disc_depth` [m] (e.g. the distance from the disc centre to the contact) and the face
+    /// The law of a pin of radius `pin_radius` \[m\] touching the disc `geometry` at the curve
+    /// parameter `phi` \[rad\] (the foot of an exact gap query), with the disc body depth
+    /// `disc_depth` \[m\] (e.g. the distance from the disc centre to the contact) and the face
     /// width of the disc. The profile curvature is [`pin_disc_profile_curvature`] of the
     /// pin-centre curve's curvature at `phi`.
     ///
@@ -283,32 +283,32 @@ impl LineContactLaw {
         )
     }
 
-    /// Contact length [m].
+    /// Contact length \[m\].
     pub fn length(&self) -> f64 {
         self.length
     }
 
-    /// Effective radius `R` [m], `1/R = kappa_1 + kappa_2`.
+    /// Effective radius `R` \[m\], `1/R = kappa_1 + kappa_2`.
     pub fn effective_radius(&self) -> f64 {
         self.radius
     }
 
-    /// Effective modulus `E*` [Pa].
+    /// Effective modulus `E*` \[Pa\].
     pub fn effective_modulus(&self) -> f64 {
         self.e_star
     }
 
-    /// Reference depths `[h_1, h_2]` [m].
+    /// Reference depths `[h_1, h_2]` \[m\].
     pub fn depths(&self) -> [f64; 2] {
         self.depths
     }
 
-    /// Force [N] above which the law is continued linearly (`a = min(h_1, h_2, R)/2`).
+    /// Force \[N\] above which the law is continued linearly (`a = min(h_1, h_2, R)/2`).
     pub fn validity_limit(&self) -> f64 {
         self.f_lim
     }
 
-    /// Hertz half width `a = sqrt(4 F R / (pi L E*))` [m] at the force `force` [N].
+    /// Hertz half width `a = sqrt(4 F R / (pi L E*))` \[m\] at the force `force` \[N\].
     ///
     /// Errors (`Parameter`) for a negative or non-finite force.
     pub fn half_width(&self, force: f64) -> Result<f64> {
@@ -316,7 +316,7 @@ impl LineContactLaw {
         Ok(self.alpha * force.sqrt())
     }
 
-    /// Hertz peak pressure `p0 = 2 F / (pi L a) = sqrt(F E* / (pi L R))` [Pa] at `force` [N].
+    /// Hertz peak pressure `p0 = 2 F / (pi L a) = sqrt(F E* / (pi L R))` \[Pa\] at `force` \[N\].
     ///
     /// Errors (`Parameter`) for a negative or non-finite force.
     pub fn peak_pressure(&self, force: f64) -> Result<f64> {
@@ -324,7 +324,7 @@ impl LineContactLaw {
         Ok((force * self.e_star / (PI * self.length * self.radius)).sqrt())
     }
 
-    /// The approach `delta(F)` [m] at the force `force` [N], the closed form of the module
+    /// The approach `delta(F)` \[m\] at the force `force` \[N\], the closed form of the module
     /// documentation (linear beyond [`LineContactLaw::validity_limit`]).
     ///
     /// Returns 0 at zero force. Errors (`Parameter`) for a negative or non-finite force.
@@ -357,7 +357,7 @@ impl LineContactLaw {
         }
     }
 
-    /// Contact force [N] at the approach `delta` [m]: 0 for `delta <= 0` (and for NaN).
+    /// Contact force \[N\] at the approach `delta` \[m\]: 0 for `delta <= 0` (and for NaN).
     ///
     /// Inverts `delta = e^x (K0 - K1 x)`, `x = ln F`, by Newton's method on
     /// `g(x) = x + ln(K0 - K1 x) - ln delta`. `g` is increasing and concave below the validity
@@ -372,7 +372,7 @@ impl LineContactLaw {
         self.force_and_stiffness(delta).0
     }
 
-    /// Contact force [N] and tangent stiffness `dF/d delta` [N/m] at the approach `delta` [m].
+    /// Contact force \[N\] and tangent stiffness `dF/d delta` [N/m] at the approach `delta` \[m\].
     ///
     /// Both are 0 for `delta <= 0`; both are continuous in `delta` and tend to 0 as
     /// `delta -> 0+`.
@@ -428,7 +428,7 @@ impl LineContactLaw {
         (f, 1.0 / compliance, x)
     }
 
-    /// Elastic energy stored at the approach `delta` [m], `U = integral_0^delta F d delta` [J].
+    /// Elastic energy stored at the approach `delta` \[m\], `U = integral_0^delta F d delta` \[J\].
     ///
     /// Closed form `U = F delta - integral_0^F delta(f) df` with
     /// `integral_0^F f (K0 - K1 ln f) df = F^2 (K0/2 - K1 (ln F / 2 - 1/4))`; 0 for
@@ -464,7 +464,7 @@ pub(crate) struct PinDiscLawBase {
     inv_pin_radius: f64,
     e_star: f64,
     compliances: [f64; 2],
-    /// `pi L` [m].
+    /// `pi L` \[m\].
     pi_length: f64,
     /// `1 / (pi L E*)` [m/N].
     k1: f64,
@@ -475,7 +475,7 @@ pub(crate) struct PinDiscLawBase {
 }
 
 impl PinDiscLawBase {
-    /// For a pin of radius `pin_radius` [m] (positive, finite), the face width `face_width` [m]
+    /// For a pin of radius `pin_radius` \[m\] (positive, finite), the face width `face_width` \[m\]
     /// (positive, finite) and valid materials.
     pub(crate) fn new(pin_radius: f64, face_width: f64, pin: &Material, disc: &Material) -> Self {
         let e_star = effective_modulus(pin, disc);
@@ -499,7 +499,7 @@ impl PinDiscLawBase {
         self.compliances
     }
 
-    /// `pi L` [m].
+    /// `pi L` \[m\].
     #[inline]
     pub(crate) fn pi_length(&self) -> f64 {
         self.pi_length
@@ -512,7 +512,7 @@ impl PinDiscLawBase {
     }
 
     /// The law against a disc profile of signed curvature `kappa` [1/m] with the disc's
-    /// reference depth `h2` [m] and its logarithm `ln_h2`. Errors (`Geometry`) for a
+    /// reference depth `h2` \[m\] and its logarithm `ln_h2`. Errors (`Geometry`) for a
     /// non-positive curvature sum, as [`LineContactLaw::new`].
     #[inline]
     pub(crate) fn law(&self, kappa: f64, h2: f64, ln_h2: f64) -> Result<LineContactLaw> {
@@ -573,16 +573,16 @@ const DEPTH_BLEND_LOWER: f64 = 0.8;
 /// The disc's reference depth at a contact and its derivatives along the curvature.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DepthJet {
-    /// Reference depth `h` [m].
+    /// Reference depth `h` \[m\].
     pub depth: f64,
-    /// `d ln h / d kappa` [m].
+    /// `d ln h / d kappa` \[m\].
     pub dln_dkappa: f64,
     /// `d^2 ln h / d kappa^2` [m^2].
     pub d2ln_dkappa2: f64,
 }
 
 /// Reference depth `h` of the disc side of a pin contact, for the signed profile curvature
-/// `kappa` [1/m] and the body depth `body_depth` `D` [m] (docs/model.md, "Pin against cycloid
+/// `kappa` [1/m] and the body depth `body_depth` `D` \[m\] (docs/model.md, "Pin against cycloid
 /// disc"): `h = D` where `kappa D <= 0.8` (concave, flat or gently convex: the seat is backed
 /// by the body), `h = 1/kappa` where `kappa D >= 1.25` (the cylinder of the actual radius), and
 /// between them `ln h = ln D - r(ln(kappa D))` with the C2 ramp
@@ -645,7 +645,7 @@ pub(crate) fn disc_reference_depth_ratio(kappa: f64, body_depth: f64) -> (DepthJ
 }
 
 /// Signed curvature [1/m] of the actual cycloid profile from the signed curvature
-/// `centre_curvature` [1/m] of the pin-centre curve and the generating pin radius `r` [m]:
+/// `centre_curvature` [1/m] of the pin-centre curve and the generating pin radius `r` \[m\]:
 /// `kappa_P = kappa_C / (1 - r kappa_C)` (the profile is the inner offset of the centre curve
 /// by `r`; positive convex).
 ///

@@ -33,7 +33,7 @@ use crate::geometry::CycloidGeometry;
 /// The gap of one pin against one disc with its derivatives in the disc pose `(X, Y, theta)`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct GapJet {
-    /// Signed gap [m] (negative = penetration).
+    /// Signed gap \[m\] (negative = penetration).
     pub gap: f64,
     /// `d gap / d(X, Y, theta)` [-, -, m].
     pub grad: [f64; 3],
@@ -41,30 +41,30 @@ pub struct GapJet {
     pub hess: [[f64; 3]; 3],
     /// Unit outward profile normal at the contact, fixed frame (from the disc to the pin).
     pub normal: [f64; 2],
-    /// Contact point on the profile relative to the disc centre, fixed frame [m].
+    /// Contact point on the profile relative to the disc centre, fixed frame \[m\].
     pub arm: [f64; 2],
-    /// Curve parameter of the foot [rad] (not reduced to `[0, 2 pi)`).
+    /// Curve parameter of the foot \[rad\] (not reduced to `[0, 2 pi)`).
     pub phi: f64,
     /// `(cos phi, sin phi)` of the foot (a warm start for the next query).
     pub cos_sin: [f64; 2],
     /// `(cos, sin)` of [`GapJet::phi`] (the foot after its last Newton correction).
     pub phi_cos_sin: [f64; 2],
-    /// Signed radius of curvature of the profile at the contact [m] (positive convex).
+    /// Signed radius of curvature of the profile at the contact \[m\] (positive convex).
     pub curvature_radius: f64,
 }
 
 impl GapJet {
-    /// Lever of the normal about the disc centre, `arm x normal` [m].
+    /// Lever of the normal about the disc centre, `arm x normal` \[m\].
     #[inline]
     pub fn lever(&self) -> f64 {
         self.arm[0] * self.normal[1] - self.arm[1] * self.normal[0]
     }
 }
 
-/// The exact gap of the pin (`pin_centre` [m], `pin_radius` [m]) against `geometry` placed at
-/// `disc_centre` [m], `disc_angle` [rad], with its gradient and Hessian in the disc pose.
+/// The exact gap of the pin (`pin_centre` \[m\], `pin_radius` \[m\]) against `geometry` placed at
+/// `disc_centre` \[m\], `disc_angle` \[rad\], with its gradient and Hessian in the disc pose.
 ///
-/// `seed` is a curve parameter [rad] near the expected foot (e.g. the previous foot, or the
+/// `seed` is a curve parameter \[rad\] near the expected foot (e.g. the previous foot, or the
 /// pin angle minus the disc angle); the answer does not depend on it (the polyline seed is
 /// the fallback). Errors: non-finite input (`Parameter`), no unique foot (`Convergence`: the
 /// pin centre is beyond a centre of curvature of the pin-centre curve).
@@ -208,7 +208,7 @@ pub(crate) fn gap_jet_cs(
 }
 
 /// The pin-centre curve `C(phi) = R (cos phi, sin phi) - e (cos zp phi, sin zp phi)`
-/// (`R = rp + d_rp`, unrotated disc frame) and its derivatives of order 0 to 4 at `phi` [m]:
+/// (`R = rp + d_rp`, unrotated disc frame) and its derivatives of order 0 to 4 at `phi` \[m\]:
 /// `C^(n) = R i^n e^(i phi) - e (i zp)^n e^(i zp phi)` in complex notation.
 pub fn centre_curve_derivatives(geometry: &CycloidGeometry, phi: f64) -> [[f64; 2]; 5] {
     let (s1, c1) = phi.sin_cos();
@@ -301,8 +301,8 @@ pub struct FootJet {
     pub hess: [[f64; 3]; 3],
 }
 
-/// The [`FootJet`] of the pin at `pin_centre` [m] against `geometry` placed at `disc_centre`
-/// [m] with `(cos, sin)` of its angle `disc_cos_sin`, at the foot `phi` [rad] (from the gap
+/// The [`FootJet`] of the pin at `pin_centre` \[m\] against `geometry` placed at `disc_centre`
+/// \[m\] with `(cos, sin)` of its angle `disc_cos_sin`, at the foot `phi` \[rad\] (from the gap
 /// query). `None` where `G_phi <= 0` (no unique foot).
 pub fn foot_jet(
     geometry: &CycloidGeometry,
@@ -385,7 +385,7 @@ pub fn foot_jet_with(
 /// `kappa_P = kappa_C / (1 - r kappa_C)` and its derivatives.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LineJet {
-    /// Elastic force [N].
+    /// Elastic force \[N\].
     pub force: f64,
     /// `dF/d delta` [N/m].
     pub stiffness: f64,
@@ -416,8 +416,8 @@ impl LineJet {
     }
 }
 
-/// The [`LineJet`] of a pin of radius `pin_radius` [m] touching `geometry` at `phi` with the
-/// approach `pen` [m] (> 0), body depth `depth` [m] and the materials; `ln_guess` warm-starts
+/// The [`LineJet`] of a pin of radius `pin_radius` \[m\] touching `geometry` at `phi` with the
+/// approach `pen` \[m\] (> 0), body depth `depth` \[m\] and the materials; `ln_guess` warm-starts
 /// the force inversion. Errors as
 /// [`crate::contact::line_contact::LineContactLaw::cycloid_contact`].
 #[allow(clippy::too_many_arguments)]
@@ -463,7 +463,7 @@ pub fn line_jet_with(
 
 /// [`line_jet_with`] for a positive finite pin radius and depth and valid materials (checked
 /// once, at the scene's build), given as the contact-independent part `base` of the law and the
-/// body depth `depth` [m] with its logarithm `ln_depth`: the same jet to round-off (one
+/// body depth `depth` \[m\] with its logarithm `ln_depth`: the same jet to round-off (one
 /// logarithm fewer per contact, see [`crate::contact::line_contact::PinDiscLawBase`]), without
 /// re-checking the input at every contact.
 #[inline]

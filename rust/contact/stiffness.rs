@@ -78,9 +78,9 @@ impl ContactCondition {
 /// Inputs of the paper's stiffness formula (SI units).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StiffnessParams {
-    /// Pin radius `R1` [m].
+    /// Pin radius `R1` \[m\].
     pub r1: f64,
-    /// Magnitude of the disc profile's radius of curvature at the contact `R2` [m].
+    /// Magnitude of the disc profile's radius of curvature at the contact `R2` \[m\].
     pub r2: f64,
     /// Convex-convex or convex-concave.
     pub condition: ContactCondition,
@@ -90,7 +90,7 @@ pub struct StiffnessParams {
     pub material2: Material,
     /// IMPACT force exponent `e` [-] (paper 1.5).
     pub exponent: f64,
-    /// IMPACT penetration depth parameter `x` of eq. 10 [m] (paper 0.01 mm = 1e-5 m).
+    /// IMPACT penetration depth parameter `x` of eq. 10 \[m\] (paper 0.01 mm = 1e-5 m).
     pub penetration: f64,
 }
 
@@ -136,7 +136,7 @@ impl StiffnessParams {
         Ok(())
     }
 
-    /// Effective radius `R` of eq. 7 [m]: `R1 R2/(R1 + R2)` or `R1 R2/(R2 - R1)`.
+    /// Effective radius `R` of eq. 7 \[m\]: `R1 R2/(R1 + R2)` or `R1 R2/(R2 - R1)`.
     ///
     /// Returns `R` without validation; call [`StiffnessParams::validate`] first.
     pub fn effective_radius(&self) -> f64 {
@@ -152,17 +152,17 @@ impl StiffnessParams {
 pub struct StiffnessTerms {
     /// `k'` of eq. 6 [N/m^1.5].
     pub coefficient: f64,
-    /// `F = k' x^e` of eq. 10 [N].
+    /// `F = k' x^e` of eq. 10 \[N\].
     pub force: f64,
-    /// Roark's full contact width `b` of eq. 11 [m].
+    /// Roark's full contact width `b` of eq. 11 \[m\].
     pub full_width: f64,
-    /// Contact deformation `w` of eq. 9 [m].
+    /// Contact deformation `w` of eq. 9 \[m\].
     pub deformation: f64,
     /// `k = k' sqrt(w)` of eq. 5, w in mm, read as N/mm^e and converted [N/m^e].
     pub stiffness: f64,
 }
 
-/// All terms of eqs. 5-11 at contact width `width` [m].
+/// All terms of eqs. 5-11 at contact width `width` \[m\].
 ///
 /// Returns [`StiffnessTerms`]. Errors: invalid parameters (see
 /// [`StiffnessParams::validate`]), `width` not finite and > 0, or a width so small that the
@@ -225,7 +225,7 @@ pub fn contact_stiffness_terms(width: f64, p: &StiffnessParams) -> Result<Stiffn
     })
 }
 
-/// The paper's contact stiffness `k` [N/m^exponent] at contact width `width` [m].
+/// The paper's contact stiffness `k` [N/m^exponent] at contact width `width` \[m\].
 ///
 /// Returns `k` of eq. 5 (see the module doc for the unit convention and for how it compares
 /// with the paper). Errors as [`contact_stiffness_terms`].
@@ -233,7 +233,7 @@ pub fn contact_stiffness(width: f64, p: &StiffnessParams) -> Result<f64> {
     contact_stiffness_terms(width, p).map(|t| t.stiffness)
 }
 
-/// [`contact_stiffness`] at each width [m]; returns the stiffnesses [N/m^exponent] in order,
+/// [`contact_stiffness`] at each width \[m\]; returns the stiffnesses [N/m^exponent] in order,
 /// or the first error.
 pub fn contact_stiffness_many(widths: &[f64], p: &StiffnessParams) -> Result<Vec<f64>> {
     widths.iter().map(|&w| contact_stiffness(w, p)).collect()
@@ -242,7 +242,7 @@ pub fn contact_stiffness_many(widths: &[f64], p: &StiffnessParams) -> Result<Vec
 /// Samples of the coarse scan that brackets the maximum before the golden-section search.
 const SCAN_SAMPLES: usize = 64;
 
-/// Width [m] and value [N/m^exponent] of the largest stiffness for widths in `[lo, hi]` [m].
+/// Width \[m\] and value [N/m^exponent] of the largest stiffness for widths in `[lo, hi]` \[m\].
 ///
 /// A log-spaced scan brackets the largest sample, then a golden-section search (in ln width)
 /// refines it to 1e-10 relative. Returns `(width_at_max, k_max)` for an interior maximum.

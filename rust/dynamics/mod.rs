@@ -3,7 +3,7 @@
 //! - [`scene`]: the reducer description (schema, validation, the paper's preset);
 //! - [`model`]: the equations of motion built from a scene: the parts shared by both models,
 //!   the rigid-joint and the compliant-joint model, the contact and bearing laws;
-//! - [`run`]: the driver that integrates a model with a registered integrator
+//! - [`run`](mod@run): the driver that integrates a model with a registered integrator
 //!   ([`crate::solve`]) and records the channels into a [`Recording`].
 
 #![warn(missing_docs)]

@@ -46,17 +46,17 @@ pub const ISO6336_CM: f64 = 0.8;
 pub struct IsoGearPair {
     /// Teeth of gear 1 (pinion) and gear 2.
     pub teeth: [u32; 2],
-    /// Normal module `m_n` [m].
+    /// Normal module `m_n` \[m\].
     pub module: f64,
-    /// Normal pressure angle of the basic rack `alpha_Pn` [rad].
+    /// Normal pressure angle of the basic rack `alpha_Pn` \[rad\].
     pub pressure_angle: f64,
-    /// Helix angle `beta` [rad] (0 for spur gears).
+    /// Helix angle `beta` \[rad\] (0 for spur gears).
     pub helix_angle: f64,
     /// Profile shift coefficients `x1`, `x2` [-].
     pub profile_shift: [f64; 2],
-    /// Common face width `b` [m].
+    /// Common face width `b` \[m\].
     pub face_width: f64,
-    /// Dedendum of the basic rack `h_fP` [m] (standard: `1.25 m_n`).
+    /// Dedendum of the basic rack `h_fP` \[m\] (standard: `1.25 m_n`).
     pub rack_dedendum: f64,
     /// Gear blank factor `C_R` [-] (1 for solid blanks; see [`rim_blank_factor`]).
     pub blank_factor: f64,
@@ -65,7 +65,7 @@ pub struct IsoGearPair {
 impl IsoGearPair {
     /// A solid, unshifted spur pair with the standard basic rack (`h_fP = 1.25 m`).
     ///
-    /// Module [m], pressure angle [rad], face width [m].
+    /// Module \[m\], pressure angle \[rad\], face width \[m\].
     pub fn spur(z1: u32, z2: u32, module: f64, pressure_angle: f64, face_width: f64) -> Self {
         Self {
             teeth: [z1, z2],
@@ -188,8 +188,8 @@ impl IsoGearPair {
 }
 
 /// Gear blank factor `C_R = 1 + ln(b_s / b) / (5 exp(s_R / (5 m_n)))` [-] (ISO 6336-1) for a
-/// web of width `web_width` `b_s` [m] under a face width `face_width` `b` [m] and a rim
-/// thickness `rim_thickness` `s_R` [m], module `m_n` [m]; `b_s/b` is clamped to [0.2, 1.2] and
+/// web of width `web_width` `b_s` \[m\] under a face width `face_width` `b` \[m\] and a rim
+/// thickness `rim_thickness` `s_R` \[m\], module `m_n` \[m\]; `b_s/b` is clamped to [0.2, 1.2] and
 /// `s_R/m_n` to at least 1 as the standard prescribes.
 ///
 /// Errors (`Parameter`) for non-positive or non-finite inputs.
@@ -227,7 +227,7 @@ pub fn spur_contact_ratio(z1: u32, z2: u32, module: f64, pressure_angle: f64) ->
     Ok((path(z1) + path(z2) - a * s) / (PI * module * c))
 }
 
-/// Base pitch `p_b = pi m cos alpha` [m] (module [m], pressure angle [rad]).
+/// Base pitch `p_b = pi m cos alpha` \[m\] (module \[m\], pressure angle \[rad\]).
 pub fn base_pitch(module: f64, pressure_angle: f64) -> f64 {
     PI * module * pressure_angle.cos()
 }
@@ -241,7 +241,7 @@ pub struct MeshStiffnessWave {
     high: f64,
     /// Fraction of the base pitch with the extra pair, `eps - floor(eps)` [-].
     high_fraction: f64,
-    /// Base pitch [m].
+    /// Base pitch \[m\].
     base_pitch: f64,
     /// Width of each smoothing ramp as a fraction of the base pitch [-].
     ramp: f64,
@@ -249,7 +249,7 @@ pub struct MeshStiffnessWave {
 
 impl MeshStiffnessWave {
     /// The wave of a pair of single stiffness `single` [N/m] (ISO `c'` times face width),
-    /// contact ratio `contact_ratio` >= 1 [-], base pitch `base_pitch` [m], with ramps of
+    /// contact ratio `contact_ratio` >= 1 [-], base pitch `base_pitch` \[m\], with ramps of
     /// `ramp` (fraction of the base pitch, in [0, 0.5 min(f, 1 - f)] where `f` is the
     /// fractional part of the contact ratio; 0 for jumps).
     ///
@@ -296,18 +296,18 @@ impl MeshStiffnessWave {
         self.low + (self.high - self.low) * self.high_fraction
     }
 
-    /// Base pitch [m]: the period of the wave along the line of action.
+    /// Base pitch \[m\]: the period of the wave along the line of action.
     pub fn period(&self) -> f64 {
         self.base_pitch
     }
 
-    /// Stiffness [N/m] at the mesh position `s` [m] along the line of action (any real `s`;
+    /// Stiffness [N/m] at the mesh position `s` \[m\] along the line of action (any real `s`;
     /// the double zone is `[0, (eps - n) p_b)` of each period).
     pub fn stiffness(&self, s: f64) -> f64 {
         self.stiffness_and_slope(s).0
     }
 
-    /// Stiffness [N/m] and its slope `dk/ds` [N/m^2] at the mesh position `s` [m] (the slope
+    /// Stiffness [N/m] and its slope `dk/ds` [N/m^2] at the mesh position `s` \[m\] (the slope
     /// is 0 outside the ramps; with jumps (`ramp = 0`) it is 0 everywhere but at the jumps).
     /// A non-finite `s` gives the mean and 0.
     pub fn stiffness_and_slope(&self, s: f64) -> (f64, f64) {
@@ -352,7 +352,7 @@ impl MeshStiffnessWave {
 
 impl MeshStiffnessWave {
     /// Stiffness `k(s)` [N/m], slope `dk/ds` [N/m^2] and curvature `d2k/ds2` [N/m^3] at the
-    /// mesh position `s` [m]: the derivatives of [`MeshStiffnessWave::stiffness_and_slope`]'s
+    /// mesh position `s` \[m\]: the derivatives of [`MeshStiffnessWave::stiffness_and_slope`]'s
     /// ramps `3 x^2 - 2 x^3` (`x` the position within a ramp), for the static tangent of the
     /// mesh energy `V = k(s) pen^2 / 2` (quasi-static analysis, modes). The curvature jumps at
     /// the ends of each ramp (the ramp is C1); it is that of the side `s` lies on.
@@ -381,7 +381,7 @@ impl MeshStiffnessWave {
 }
 
 /// Mesh phases of the sun-planet meshes of a planetary stage, as fractions of a mesh period in
-/// [0, 1): `gamma_k = frac(z_sun psi_k / (2 pi))` for planets at the angles `psi_k` [rad]
+/// [0, 1): `gamma_k = frac(z_sun psi_k / (2 pi))` for planets at the angles `psi_k` \[rad\]
 /// (measured in the direction of the sun's rotation relative to the carrier).
 ///
 /// Planet `k` passes the same mesh position as planet 0 a time `gamma_k T_mesh` later

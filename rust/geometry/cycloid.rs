@@ -23,15 +23,15 @@ use std::f64::consts::PI;
 /// run) finite for any accepted input.
 pub const MAX_PINS: u32 = 1000;
 
-/// Smallest length accepted for a size of the reducer [m] (1 nm).
+/// Smallest length accepted for a size of the reducer \[m\] (1 nm).
 pub const MIN_LENGTH: f64 = 1e-9;
 
-/// Largest length accepted for a size of the reducer [m] (1 km). Between [`MIN_LENGTH`] and
+/// Largest length accepted for a size of the reducer \[m\] (1 km). Between [`MIN_LENGTH`] and
 /// this, every formula of the geometry (up to fourth powers of lengths, for the polar moment of
 /// area) stays far inside the range of `f64`, so no result over- or underflows.
 pub const MAX_LENGTH: f64 = 1e3;
 
-/// `value` if it is a finite length in `[MIN_LENGTH, MAX_LENGTH]` [m], else
+/// `value` if it is a finite length in `[MIN_LENGTH, MAX_LENGTH]` \[m\], else
 /// `RvdynError::Parameter` naming it and the range.
 pub fn require_length(name: &str, value: f64) -> Result<f64> {
     require_positive(name, value, "m")?;
@@ -49,7 +49,7 @@ pub fn require_length(name: &str, value: f64) -> Result<f64> {
 
 /// Check the radius of every pin with its size error: `pin_radius + errors[j]` must be a
 /// length of at least [`MIN_LENGTH`] (a pin of zero or negative radius has no surface to
-/// touch). `errors` is empty (no errors) or one value per pin [m].
+/// touch). `errors` is empty (no errors) or one value per pin \[m\].
 ///
 /// Errors (`RvdynError::Geometry`) name the first pin that breaks the rule, its error and
 /// the resulting radius.
@@ -71,7 +71,7 @@ pub fn check_pin_radii(pin_radius: f64, errors: &[f64]) -> Result<()> {
     Ok(())
 }
 
-/// Profile error of a disc: a normal offset `delta(phi)` of the ground profile [m] as a function
+/// Profile error of a disc: a normal offset `delta(phi)` of the ground profile \[m\] as a function
 /// of the curve parameter `phi` (rad; the polar angle of the pin-centre curve point in the
 /// disc frame, before the rotation modification), positive = material added (outward), so
 /// that every gap shrinks by `delta` at the contact (the opposite sign of `d_rrp`: a constant
@@ -80,11 +80,11 @@ pub fn check_pin_radii(pin_radius: f64, errors: &[f64]) -> Result<()> {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProfileError {
-    /// `[amplitude [m], order n (integer >= 0), phase p [rad]]` of each harmonic
+    /// `[amplitude \[m\], order n (integer >= 0), phase p \[rad\]]` of each harmonic
     /// `a cos(n phi + p)`.
     #[serde(default)]
     pub harmonics: Vec<[f64; 3]>,
-    /// `[phi [rad], offset [m]]` points, `phi` strictly increasing in `[0, 2 pi)`; linear in
+    /// `[phi \[rad\], offset \[m\]]` points, `phi` strictly increasing in `[0, 2 pi)`; linear in
     /// between and periodic (the last point joins the first across `2 pi`).
     #[serde(default)]
     pub table: Vec<[f64; 2]>,
@@ -102,7 +102,7 @@ impl ProfileError {
 
     /// Check the fields; `at` names the field (`"discs[0].profile_error"`) in the message.
     /// Every number finite, orders non-negative integers, table angles strictly increasing in
-    /// `[0, 2 pi)`, and `sum |a| + max |table|` below `limit` [m].
+    /// `[0, 2 pi)`, and `sum |a| + max |table|` below `limit` \[m\].
     pub fn check(&self, at: &str, limit: f64) -> Result<()> {
         let bad = |m: String| Err(RvdynError::Scene(format!("{at}.{m}")));
         for (i, h) in self.harmonics.iter().enumerate() {
@@ -144,7 +144,7 @@ impl ProfileError {
         Ok(())
     }
 
-    /// The offset `delta(phi)` [m] and its slope `d delta / d phi` [m/rad].
+    /// The offset `delta(phi)` \[m\] and its slope `d delta / d phi` [m/rad].
     pub fn offset(&self, phi: f64) -> (f64, f64) {
         let mut d = 0.0;
         let mut s = 0.0;
@@ -189,21 +189,21 @@ pub fn periodic_table(points: &[[f64; 2]], x: f64) -> (f64, f64) {
 pub struct CycloidParams {
     /// Number of pins `zp` (the disc has `zp - 1` lobes).
     pub pins: u32,
-    /// Eccentricity `e` [m].
+    /// Eccentricity `e` \[m\].
     pub eccentricity: f64,
-    /// Pin circle radius `rp` [m].
+    /// Pin circle radius `rp` \[m\].
     pub pin_circle_radius: f64,
-    /// Pin radius `rrp` [m].
+    /// Pin radius `rrp` \[m\].
     pub pin_radius: f64,
-    /// Disc face width [m].
+    /// Disc face width \[m\].
     pub face_width: f64,
-    /// Shift modification `d_rp` [m] (grinding convention: `rp -> rp + d_rp`).
+    /// Shift modification `d_rp` \[m\] (grinding convention: `rp -> rp + d_rp`).
     #[serde(default)]
     pub d_rp: f64,
-    /// Equidistant modification `d_rrp` [m] (`rrp -> rrp + d_rrp`; positive removes material).
+    /// Equidistant modification `d_rrp` \[m\] (`rrp -> rrp + d_rrp`; positive removes material).
     #[serde(default)]
     pub d_rrp: f64,
-    /// Rotation modification `d_delta` [rad] (the profile turned by this angle).
+    /// Rotation modification `d_delta` \[rad\] (the profile turned by this angle).
     #[serde(default)]
     pub d_delta: f64,
 }
@@ -232,9 +232,9 @@ pub struct CycloidGeometry {
     params: CycloidParams,
     zp: f64,
     zc: f64,
-    /// Generating radius `rp + d_rp` [m].
+    /// Generating radius `rp + d_rp` \[m\].
     gen_radius: f64,
-    /// Generating pin radius `rrp + d_rrp` [m].
+    /// Generating pin radius `rrp + d_rrp` \[m\].
     gen_pin_radius: f64,
     k1: f64,
     min_convex_radius: f64,
@@ -377,19 +377,19 @@ impl CycloidGeometry {
     pub fn k1(&self) -> f64 {
         self.k1
     }
-    /// Minimum convex radius of curvature of the pin-centre curve [m] (undercut limit).
+    /// Minimum convex radius of curvature of the pin-centre curve \[m\] (undercut limit).
     pub fn min_convex_radius(&self) -> f64 {
         self.min_convex_radius
     }
-    /// Generating pin radius `rrp + d_rrp` [m]: the offset from the pin-centre curve to the profile.
+    /// Generating pin radius `rrp + d_rrp` \[m\]: the offset from the pin-centre curve to the profile.
     pub fn generating_pin_radius(&self) -> f64 {
         self.gen_pin_radius
     }
-    /// Pitch radius of the disc `rc' = e zc` [m].
+    /// Pitch radius of the disc `rc' = e zc` \[m\].
     pub fn pitch_radius(&self) -> f64 {
         self.params.eccentricity * self.zc
     }
-    /// Angle of pin `j` (0-based; the paper's pin `j + 1`) in the fixed frame [rad].
+    /// Angle of pin `j` (0-based; the paper's pin `j + 1`) in the fixed frame \[rad\].
     pub fn pin_angle(&self, j: usize) -> f64 {
         2.0 * PI * j as f64 / self.zp
     }
@@ -446,7 +446,7 @@ impl CycloidGeometry {
         [c * v[0] + s * v[1], -s * v[0] + c * v[1]]
     }
 
-    /// Point of the actual (ground) profile at curve parameter `phi`, disc frame [m].
+    /// Point of the actual (ground) profile at curve parameter `phi`, disc frame \[m\].
     ///
     /// ```
     /// # use rvdyn::geometry::{CycloidGeometry, cycloid::CycloidParams};
@@ -482,7 +482,7 @@ impl CycloidGeometry {
         cross / (len * len * len)
     }
 
-    /// Signed radius of curvature of the actual profile at `phi` [m]: positive where the
+    /// Signed radius of curvature of the actual profile at `phi` \[m\]: positive where the
     /// profile is convex (lobe flank and tip), negative where concave (around the root).
     /// Equals `1/kappa_C - (rrp + d_rrp)`.
     pub fn curvature_radius(&self, phi: f64) -> f64 {
@@ -525,7 +525,7 @@ fn complex_pow(c: f64, s: f64, mut n: u32) -> (f64, f64) {
     (rc, rs)
 }
 
-/// Minimum convex radius of curvature of the pin-centre curve [m].
+/// Minimum convex radius of curvature of the pin-centre curve \[m\].
 ///
 /// The curvature depends on `c = cos(zc phi)` only:
 /// `kappa = [1 + zp K1^2 - K1 (1 + zp) c] / (R S^3)`, `S^2 = 1 + K1^2 - 2 K1 c`.

@@ -12,7 +12,7 @@ use crate::geometry::profile_seed::CurveConsts;
 use std::f64::consts::PI;
 
 /// The iteration stops once its estimate of the foot error left after the last step (arc
-/// length along the pin-centre curve) is below this [m]. The gap is stationary at the foot, so
+/// length along the pin-centre curve) is below this \[m\]. The gap is stationary at the foot, so
 /// it is exact to round-off; the normal, turned by `kappa` times the foot error, to 1e-11 rad.
 pub const FOOT_TOLERANCE: f64 = 1e-14;
 const MAX_NEWTON: u32 = 40;
@@ -110,15 +110,15 @@ impl Derivs {
 /// Result of an exact gap query, in the fixed frame (SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PinGap {
-    /// Signed normal gap between the pin circle and the profile [m]; negative = penetration.
+    /// Signed normal gap between the pin circle and the profile \[m\]; negative = penetration.
     pub gap: f64,
-    /// Contact point on the disc profile, fixed frame [m].
+    /// Contact point on the disc profile, fixed frame \[m\].
     pub point: [f64; 2],
     /// Unit outward normal of the profile at the contact (points from the disc to the pin).
     pub normal: [f64; 2],
-    /// Curve parameter of the contact, in `[0, 2 pi)` [rad].
+    /// Curve parameter of the contact, in `[0, 2 pi)` \[rad\].
     pub phi: f64,
-    /// Signed radius of curvature of the profile at the contact [m] (positive convex).
+    /// Signed radius of curvature of the profile at the contact \[m\] (positive convex).
     pub curvature_radius: f64,
     /// Iterations used on the exact curve (0: found by the search around a tooth root).
     pub iterations: u32,
@@ -132,7 +132,7 @@ pub struct GapWarmStart {
     disc_angle: f64,
     cos_sin: [f64; 2],
     /// How far the foot moved along the curve, beyond the disc's rotation, at the last query
-    /// [rad]: the next query expects the same (a linear predictor along a trajectory).
+    /// \[rad\]: the next query expects the same (a linear predictor along a trajectory).
     drift: f64,
 }
 
@@ -153,7 +153,7 @@ pub(crate) struct LocalFoot {
     pub phi: f64,
     /// `cos phi`, `sin phi`.
     pub cos_sin: [f64; 2],
-    /// Signed distance `(p - C) . n` [m].
+    /// Signed distance `(p - C) . n` \[m\].
     pub dist: f64,
     /// Outward unit normal at the foot.
     pub normal: [f64; 2],
@@ -187,7 +187,7 @@ impl LocalFoot {
 
 /// A foot, or a pin shown to be farther from the curve than asked
 /// ([`CycloidGeometry::contact_foot_or_open`]), with the lower bound of its signed distance
-/// [m] that showed it.
+/// \[m\] that showed it.
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum FootOrOpen {
     Foot(LocalFoot),
@@ -240,9 +240,9 @@ fn bracketed_root(g: impl Fn(f64) -> (f64, f64), a: f64, b: f64) -> Option<f64> 
 }
 
 impl CycloidGeometry {
-    /// Exact gap between pin circle (centre `pin_center` [m], radius the disc's `pin_radius`)
-    /// and the profile of this disc placed with its centre at `disc_center` [m] and turned by
-    /// `disc_angle` [rad] (fixed frame).
+    /// Exact gap between pin circle (centre `pin_center` \[m\], radius the disc's `pin_radius`)
+    /// and the profile of this disc placed with its centre at `disc_center` \[m\] and turned by
+    /// `disc_angle` \[rad\] (fixed frame).
     ///
     /// Returns the signed gap (negative = penetration), the contact point on the profile, the
     /// outward unit normal, the curve parameter and the local curvature radius. The gap is the
@@ -276,7 +276,7 @@ impl CycloidGeometry {
         )
     }
 
-    /// As [`CycloidGeometry::gap`] for a pin of another radius [m] (pin radius errors).
+    /// As [`CycloidGeometry::gap`] for a pin of another radius \[m\] (pin radius errors).
     pub fn gap_with_pin_radius(
         &self,
         pin_center: [f64; 2],
@@ -295,7 +295,7 @@ impl CycloidGeometry {
     }
 
     /// As [`CycloidGeometry::gap_with_pin_radius`], starting the iteration from `seed_phi`
-    /// [rad]; the polyline seed is used only if it fails from there. For hot loops that know
+    /// \[rad\]; the polyline seed is used only if it fails from there. For hot loops that know
     /// where the contact was (previous step) or should be (kinematics).
     pub fn gap_seeded(
         &self,

@@ -49,20 +49,20 @@ pub struct InvoluteStage {
     pub z_planet: u32,
     /// Number of planets (equally spaced).
     pub planets: u32,
-    /// Module `m` [m].
+    /// Module `m` \[m\].
     pub module: f64,
-    /// Pressure angle `alpha` [rad].
+    /// Pressure angle `alpha` \[rad\].
     pub pressure_angle: f64,
-    /// Face width [m].
+    /// Face width \[m\].
     pub face_width: f64,
-    /// Total backlash of one mesh, measured along the line of action [m].
+    /// Total backlash of one mesh, measured along the line of action \[m\].
     #[serde(default)]
     pub backlash: f64,
 }
 
 impl InvoluteStage {
-    /// Build a validated stage without backlash: teeth, planets, module [m], pressure angle
-    /// [rad], face width [m].
+    /// Build a validated stage without backlash: teeth, planets, module \[m\], pressure angle
+    /// \[rad\], face width \[m\].
     ///
     /// Errors as [`InvoluteStage::validate`].
     pub fn new(
@@ -86,7 +86,7 @@ impl InvoluteStage {
         Ok(stage)
     }
 
-    /// The same stage with a total backlash [m] along the line of action.
+    /// The same stage with a total backlash \[m\] along the line of action.
     ///
     /// Errors (`Parameter`) for a negative or non-finite backlash.
     pub fn with_backlash(mut self, backlash: f64) -> Result<Self> {
@@ -174,47 +174,47 @@ impl InvoluteStage {
         Ok(())
     }
 
-    /// Sun pitch radius `m z1 / 2` [m].
+    /// Sun pitch radius `m z1 / 2` \[m\].
     pub fn sun_pitch_radius(&self) -> f64 {
         0.5 * self.module * f64::from(self.z_sun)
     }
 
-    /// Planet pitch radius `m z2 / 2` [m].
+    /// Planet pitch radius `m z2 / 2` \[m\].
     pub fn planet_pitch_radius(&self) -> f64 {
         0.5 * self.module * f64::from(self.z_planet)
     }
 
-    /// Sun base radius `r1 cos(alpha)` [m].
+    /// Sun base radius `r1 cos(alpha)` \[m\].
     pub fn sun_base_radius(&self) -> f64 {
         self.sun_pitch_radius() * self.pressure_angle.cos()
     }
 
-    /// Planet base radius `r2 cos(alpha)` [m].
+    /// Planet base radius `r2 cos(alpha)` \[m\].
     pub fn planet_base_radius(&self) -> f64 {
         self.planet_pitch_radius() * self.pressure_angle.cos()
     }
 
-    /// Centre distance `a = r1 + r2` [m], which is also the crank circle radius.
+    /// Centre distance `a = r1 + r2` \[m\], which is also the crank circle radius.
     pub fn centre_distance(&self) -> f64 {
         self.sun_pitch_radius() + self.planet_pitch_radius()
     }
 
-    /// Addendum [m]: equal to the module (standard full depth).
+    /// Addendum \[m\]: equal to the module (standard full depth).
     pub fn addendum(&self) -> f64 {
         self.module
     }
 
-    /// Sun tip radius `r1 + m` [m].
+    /// Sun tip radius `r1 + m` \[m\].
     pub fn sun_tip_radius(&self) -> f64 {
         self.sun_pitch_radius() + self.addendum()
     }
 
-    /// Planet tip radius `r2 + m` [m].
+    /// Planet tip radius `r2 + m` \[m\].
     pub fn planet_tip_radius(&self) -> f64 {
         self.planet_pitch_radius() + self.addendum()
     }
 
-    /// Length of the path of contact along the line of action [m].
+    /// Length of the path of contact along the line of action \[m\].
     ///
     /// Returns `[sqrt(ra1^2 - rb1^2) - r1 sin(alpha)] + [sqrt(ra2^2 - rb2^2) - r2 sin(alpha)]`
     /// (the standard `sqrt(ra1^2-rb1^2) + sqrt(ra2^2-rb2^2) - a sin(alpha)`), except that each
@@ -245,7 +245,7 @@ impl InvoluteStage {
         self.line_of_action_length() / (PI * self.module * self.pressure_angle.cos())
     }
 
-    /// Angles of the planet centres about the axis [rad]: `2 pi k / planets`, `k = 0..planets`,
+    /// Angles of the planet centres about the axis \[rad\]: `2 pi k / planets`, `k = 0..planets`,
     /// planet 0 on +x, in the carrier frame.
     pub fn planet_angles(&self) -> Vec<f64> {
         let n = f64::from(self.planets);

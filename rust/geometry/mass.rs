@@ -30,10 +30,10 @@ pub fn require_density(density: f64) -> Result<f64> {
     }
 }
 
-/// Mass [kg] and moment of inertia about the body's own axis [kg m^2].
+/// Mass \[kg\] and moment of inertia about the body's own axis [kg m^2].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MassProperties {
-    /// Mass [kg].
+    /// Mass \[kg\].
     pub mass: f64,
     /// Moment of inertia about the body's own axis [kg m^2].
     pub inertia: f64,
@@ -42,17 +42,17 @@ pub struct MassProperties {
 /// Holes cut through a cycloid disc (radii and hole-circle radius in m).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DiscHoles {
-    /// Central bore radius [m].
+    /// Central bore radius \[m\].
     pub bore_radius: f64,
-    /// Radius of the circle the crank and pillar holes sit on [m].
+    /// Radius of the circle the crank and pillar holes sit on \[m\].
     pub hole_circle_radius: f64,
-    /// Number of crank (eccentric bearing) holes and their radius [m].
+    /// Number of crank (eccentric bearing) holes and their radius \[m\].
     pub crank_holes: u32,
-    /// Radius of each crank hole [m].
+    /// Radius of each crank hole \[m\].
     pub crank_hole_radius: f64,
-    /// Number of pillar holes (between the crank holes) and their radius [m].
+    /// Number of pillar holes (between the crank holes) and their radius \[m\].
     pub pillar_holes: u32,
-    /// Radius of each pillar hole [m].
+    /// Radius of each pillar hole \[m\].
     pub pillar_hole_radius: f64,
 }
 
@@ -197,7 +197,7 @@ pub fn disc_mass_properties(
     Ok(mp)
 }
 
-/// Solid cylinder of radius `r` [m] and length `l` [m]: mass and inertia about its axis.
+/// Solid cylinder of radius `r` \[m\] and length `l` \[m\]: mass and inertia about its axis.
 pub fn solid_cylinder(r: f64, l: f64, density: f64) -> MassProperties {
     let m = density * PI * r * r * l;
     MassProperties {

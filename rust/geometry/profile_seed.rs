@@ -28,13 +28,13 @@ pub struct ProfileSeed {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct CurveConsts {
     pub zp: u32,
-    /// Generating radius `R = rp + d_rp` [m].
+    /// Generating radius `R = rp + d_rp` \[m\].
     pub r: f64,
-    /// `e zp^k` for k = 0..=4 [m].
+    /// `e zp^k` for k = 0..=4 \[m\].
     pub ez: [f64; 5],
-    /// Lobe pitch `2 pi / zc` [rad]; the roots are at its multiples.
+    /// Lobe pitch `2 pi / zc` \[rad\]; the roots are at its multiples.
     pub pitch: f64,
-    /// Pin centres farther outside `C` than this [m] may have more than one local foot (they
+    /// Pin centres farther outside `C` than this \[m\] may have more than one local foot (they
     /// can lie beyond the evolute of a concave root); half the smallest concave radius of
     /// curvature of `C`, infinite if `C` has no concave part.
     pub ambiguity_distance: f64,
@@ -99,7 +99,7 @@ impl ProfileSeed {
         }
     }
 
-    /// Parameter step between vertices [rad] of `geometry`'s polyline.
+    /// Parameter step between vertices \[rad\] of `geometry`'s polyline.
     fn dphi(&self, geometry: &CycloidGeometry) -> f64 {
         2.0 * PI / (self.per_lobe * geometry.lobes() as usize) as f64
     }

@@ -14,7 +14,7 @@ pub const PAPER_PRINTED_OUTPUT_TORQUE: f64 = 4024.9;
 /// Speeds [rad/s] and torques [N m] at one lossless operating point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OperatingPoint {
-    /// Transmitted power [W].
+    /// Transmitted power \[W\].
     pub power: f64,
     /// Input (sun) speed [rad/s].
     pub input_speed: f64,
@@ -28,7 +28,7 @@ pub struct OperatingPoint {
     pub ratio: f64,
 }
 
-/// Operating point for `power` [W] at `input_speed` [rad/s] through `ratio` [-], without
+/// Operating point for `power` \[W\] at `input_speed` [rad/s] through `ratio` [-], without
 /// losses.
 ///
 /// Returns speeds and torques with `input_torque * input_speed = output_torque * output_speed

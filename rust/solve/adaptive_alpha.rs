@@ -12,7 +12,7 @@
 //! analysis, Earthquake Eng. Struct. Dyn. 20, 1991), `e_q = (b - 1/6) h^2 (a1 - a0)`; the
 //! Arnold-Bruls form makes `a0`, `a1` the true end accelerations it needs.
 //!
-//! **Norm.** As dopri5's: displacements at each coordinate's lever against `atol` [m],
+//! **Norm.** As dopri5's: displacements at each coordinate's lever against `atol` \[m\],
 //! velocities over [`VELOCITY_ERROR_TIME`] against `atol + rtol |v|`, weighted RMS over both;
 //! then per unit step, times `VELOCITY_ERROR_TIME / h` (the error the step's rate would
 //! accumulate over that time). The local error of a second-order method is `O(h^3)`, so this
@@ -69,7 +69,7 @@ pub static ENTRY: IntegratorEntry = IntegratorEntry {
 #[derive(Debug)]
 pub struct AdaptiveAlpha {
     stepper: GeneralizedAlpha,
-    /// Step of the next try [s].
+    /// Step of the next try \[s\].
     pub h: f64,
     rtol: f64,
     atol: f64,
@@ -93,7 +93,7 @@ pub struct AdaptiveAlpha {
     marked: bool,
     /// Error-test rejections since the run last passed the end of a rejected step.
     streak: u32,
-    /// End time of the last rejected step [s] (-inf without one).
+    /// End time of the last rejected step \[s\] (-inf without one).
     streak_end: f64,
 }
 
@@ -103,7 +103,7 @@ pub struct AdaptiveAlpha {
 pub const MAX_REJECTIONS: u32 = 4;
 
 impl AdaptiveAlpha {
-    /// Build from the run settings: `dt` is the first step, `atol` [m] and `rtol` the
+    /// Build from the run settings: `dt` is the first step, `atol` \[m\] and `rtol` the
     /// tolerances (the Newton tolerance is a tenth of `atol`).
     pub fn new(s: &Settings) -> Result<Self> {
         let bad = |m: String| Err(RvdynError::Parameter(m));

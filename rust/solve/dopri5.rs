@@ -1,7 +1,7 @@
 //! Adaptive Dormand-Prince 5(4) with an error norm on displacements.
 //!
 //! The error of coordinate `i` is weighed by its lever `L_i` (m per rad): a position error
-//! counts as `|e_q| L_i` against `atol` [m]; a velocity error as `|e_v| L_i tau` against
+//! counts as `|e_q| L_i` against `atol` \[m\]; a velocity error as `|e_v| L_i tau` against
 //! `atol + rtol |v_i| L_i tau` with `tau = 1 ms`, so that `atol` bounds both the displacement
 //! error and the displacement a velocity error makes within a millisecond. No relative
 //! tolerance on positions: absolute angles grow without bound and say nothing about accuracy.
@@ -25,7 +25,7 @@ pub static ENTRY: IntegratorEntry = IntegratorEntry {
     },
 };
 
-/// Time over which a velocity error is turned into a displacement error [s].
+/// Time over which a velocity error is turned into a displacement error \[s\].
 pub const VELOCITY_ERROR_TIME: f64 = 1e-3;
 
 /// `h lambda` beyond which a step counts as limited by stability, not accuracy (Hairer &
@@ -35,7 +35,7 @@ const STIFF_H_LAMBDA: f64 = 3.25;
 /// Stability-limited steps (with fewer than 6 others between them) before the run counts as
 /// stiff (Hairer's DOPRI5 code uses 15).
 const STIFF_STEPS: u32 = 15;
-/// A stiff run stops when its step is below this [s]: more than 10^7 steps per simulated
+/// A stiff run stops when its step is below this \[s\]: more than 10^7 steps per simulated
 /// second, where the implicit method takes 10^4 (the legitimate steps of the default scenes
 /// are 1e-5 to 1e-4 s).
 pub const STIFF_STEP_FLOOR: f64 = 1e-7;
@@ -97,13 +97,13 @@ const E: [f64; 7] = [
 pub struct Dopri5 {
     /// Relative tolerance on velocities.
     pub rtol: f64,
-    /// Displacement tolerance [m].
+    /// Displacement tolerance \[m\].
     pub atol: f64,
-    /// Current step proposal [s].
+    /// Current step proposal \[s\].
     pub h: f64,
-    /// Smallest step allowed before the run is declared failed [s].
+    /// Smallest step allowed before the run is declared failed \[s\].
     pub h_min: f64,
-    /// Largest step [s].
+    /// Largest step \[s\].
     pub h_max: f64,
     /// Most accepted steps before the run is declared failed.
     pub max_steps: u64,
@@ -127,7 +127,7 @@ pub struct Dopri5 {
 }
 
 impl Dopri5 {
-    /// A controller starting with step `h0` [s].
+    /// A controller starting with step `h0` \[s\].
     pub fn new(rtol: f64, atol: f64, h0: f64, h_max: f64) -> Self {
         Self {
             rtol,

@@ -64,7 +64,7 @@ pub struct Attempt {
     pub p0: Vec<f64>,
     /// Pseudo-acceleration at the end of the step.
     pub p1: Vec<f64>,
-    /// The step [s].
+    /// The step \[s\].
     pub h: f64,
     /// Largest contraction factor of the Newton iteration of this step, over increments above
     /// the Newton tolerance (0 if none was measured).
@@ -91,7 +91,7 @@ pub struct GeneralizedAlpha {
     af: f64,
     beta: f64,
     gamma: f64,
-    /// Newton tolerance on the displacement increment [m].
+    /// Newton tolerance on the displacement increment \[m\].
     pub newton_tol: f64,
     /// Fraction of the step's local error estimate below which Newton stops (within
     /// `[newton_tol, NEWTON_LOOSEST newton_tol]`); 0 iterates to `newton_tol` always.
@@ -202,7 +202,7 @@ impl GeneralizedAlpha {
         (self.beta, self.gamma)
     }
 
-    /// Advance `st` by `h` [s] (in sub-steps if Newton needs them).
+    /// Advance `st` by `h` \[s\] (in sub-steps if Newton needs them).
     pub fn step<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,

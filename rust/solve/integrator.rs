@@ -11,19 +11,19 @@ use crate::solve::{MechanicalSystem, State};
 /// The settings an integrator is built from (a subset of the run options, SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
-    /// End time of the run [s].
+    /// End time of the run \[s\].
     pub t_end: f64,
-    /// Step [s] of a fixed-step method; initial step of an adaptive one.
+    /// Step \[s\] of a fixed-step method; initial step of an adaptive one.
     pub dt: f64,
     /// Relative tolerance (adaptive method, velocities).
     pub rtol: f64,
-    /// Absolute displacement tolerance [m] (error control, Newton tolerance).
+    /// Absolute displacement tolerance \[m\] (error control, Newton tolerance).
     pub atol: f64,
     /// Spectral radius at infinite frequency (generalized-alpha).
     pub rho_inf: f64,
-    /// Largest step an adaptive method may take [s].
+    /// Largest step an adaptive method may take \[s\].
     pub h_max: f64,
-    /// Smallest step an adaptive method may take [s] (below it the run fails).
+    /// Smallest step an adaptive method may take \[s\] (below it the run fails).
     pub h_min: f64,
     /// Most steps an adaptive method may take (beyond it the run fails).
     pub max_steps: u64,
@@ -36,14 +36,14 @@ pub struct Settings {
 pub struct Stats {
     /// Named counts, e.g. `("steps", 10000)`, `("evaluations", 11532)`.
     pub counts: Vec<(&'static str, u64)>,
-    /// The fixed step actually used [s]; `None` for an adaptive method.
+    /// The fixed step actually used \[s\]; `None` for an adaptive method.
     pub dt: Option<f64>,
 }
 
 /// A time integrator bound to one run.
 pub trait Integrator: Send {
     /// Advance `st` by one step (possibly made of sub-steps or retried tries) that ends at or
-    /// before `t_end` [s]; a fixed-step method lands exactly on `t_end` with its last step.
+    /// before `t_end` \[s\]; a fixed-step method lands exactly on `t_end` with its last step.
     fn advance(&mut self, sys: &dyn MechanicalSystem, st: &mut State, t_end: f64) -> Result<()>;
     /// Counts of the work done so far.
     fn stats(&self) -> Stats;
@@ -70,7 +70,7 @@ pub struct IntegratorEntry {
     pub name: &'static str,
     /// Other accepted spellings (lower case, `-` for `_`).
     pub aliases: &'static [&'static str],
-    /// Default step [s] (the initial step of an adaptive method).
+    /// Default step \[s\] (the initial step of an adaptive method).
     pub default_dt: f64,
     /// Whether the step size is chosen by the method.
     pub adaptive: bool,
@@ -134,7 +134,7 @@ impl Method {
         self.0.name
     }
 
-    /// Default step [s].
+    /// Default step \[s\].
     pub fn default_dt(&self) -> f64 {
         self.0.default_dt
     }
@@ -149,7 +149,7 @@ impl Method {
 /// last one landing exactly on `t_end` (no round-off drift of the end time).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FixedClock {
-    /// The step [s].
+    /// The step \[s\].
     pub h: f64,
     /// Number of steps to `t_end`.
     pub n: u64,
@@ -159,7 +159,7 @@ pub struct FixedClock {
 }
 
 impl FixedClock {
-    /// Equal steps of at most `dt` [s] to `t_end` [s].
+    /// Equal steps of at most `dt` \[s\] to `t_end` \[s\].
     pub fn new(t_end: f64, dt: f64) -> Self {
         let n = (t_end / dt).ceil().max(1.0) as u64;
         Self {

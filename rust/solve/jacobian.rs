@@ -10,7 +10,7 @@
 use crate::error::Result;
 use crate::solve::{MechanicalSystem, State};
 
-/// Displacement perturbation at the lever [m].
+/// Displacement perturbation at the lever \[m\].
 pub const DISPLACEMENT_STEP: f64 = 1e-9;
 /// Velocity perturbation at the lever [m/s].
 pub const VELOCITY_STEP: f64 = 1e-6;

@@ -31,7 +31,7 @@ pub struct Rk4 {
 }
 
 impl Rk4 {
-    /// Advance `st` by `h` [s].
+    /// Advance `st` by `h` \[s\].
     #[allow(clippy::needless_range_loop)]
     pub fn step<S: MechanicalSystem + ?Sized>(
         &mut self,

@@ -7,10 +7,10 @@ use crate::error::Result;
 pub trait MechanicalSystem {
     /// Number of free coordinates.
     fn dof(&self) -> usize;
-    /// Accelerations `a = M^-1 Q(t, q, v)` and the power flows `[input, output, dissipated]` [W].
+    /// Accelerations `a = M^-1 Q(t, q, v)` and the power flows `[input, output, dissipated]` \[W\].
     fn eval(&self, t: f64, q: &[f64], v: &[f64], a: &mut [f64], power: &mut [f64; 3])
     -> Result<()>;
-    /// Length per unit of each coordinate [m] (a lever arm for an angle): error control and
+    /// Length per unit of each coordinate \[m\] (a lever arm for an angle): error control and
     /// Newton convergence act on displacements, not on angles that grow to tens of radians.
     fn length_scale(&self) -> &[f64];
     /// Remember which contacts are open at the state of the last [`eval`](Self::eval) (an
@@ -28,7 +28,7 @@ pub trait MechanicalSystem {
 /// The integrated state: coordinates, velocities, accelerations and energy flows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
-    /// Time [s].
+    /// Time \[s\].
     pub t: f64,
     /// Free coordinates.
     pub q: Vec<f64>,
@@ -36,9 +36,9 @@ pub struct State {
     pub v: Vec<f64>,
     /// Acceleration at `t` (for dense output and the generalized-alpha recursion).
     pub a: Vec<f64>,
-    /// Power flows at `t` `[input, output, dissipated]` [W].
+    /// Power flows at `t` `[input, output, dissipated]` \[W\].
     pub power: [f64; 3],
-    /// Integrated `[input work, output work, dissipated energy]` [J].
+    /// Integrated `[input work, output work, dissipated energy]` \[J\].
     pub work: [f64; 3],
 }
 

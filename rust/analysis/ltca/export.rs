@@ -17,19 +17,19 @@ pub struct FeaLoad {
     pub disc: usize,
     /// Pin number (1-based, the paper's numbering).
     pub pin: usize,
-    /// Crank angle [rad] of this load case.
+    /// Crank angle \[rad\] of this load case.
     pub crank_angle: f64,
     /// Output torque [N m] of this load case.
     pub torque: f64,
-    /// Normal force [N]; the pin pushes the disc along `-normal`.
+    /// Normal force \[N\]; the pin pushes the disc along `-normal`.
     pub force: f64,
-    /// Contact point on the profile [m] (disc frame).
+    /// Contact point on the profile \[m\] (disc frame).
     pub point: [f64; 2],
     /// Outward unit normal of the profile (disc frame).
     pub normal: [f64; 2],
-    /// Hertz half-width [m].
+    /// Hertz half-width \[m\].
     pub half_width: f64,
-    /// Hertz peak pressure [Pa].
+    /// Hertz peak pressure \[Pa\].
     pub peak_pressure: f64,
 }
 

@@ -515,7 +515,7 @@ impl Ltca {
     /// output torque `torque`, with every contact sliding as the running reducer slides (the
     /// kinematic rate of the full coordinates per crank angle, the input driving against the
     /// load: the crank angle decreasing for `torque > 0`, increasing for `torque < 0`). Returns
-    /// per crank angle the transmission error [rad] and the torque the held input carries
+    /// per crank angle the transmission error \[rad\] and the torque the held input carries
     /// [N m]; with the ratio `i`, `torque / (i input_torque)` is the quasi-static efficiency.
     pub fn friction_sweep(
         &mut self,
@@ -561,7 +561,7 @@ fn not_converged(psi: f64, torque: f64, res: f64, it: usize) -> RvdynError {
 }
 
 impl Ltca {
-    /// The twist [rad] of the sliding equilibrium at `torque` along `direction`.
+    /// The twist \[rad\] of the sliding equilibrium at `torque` along `direction`.
     fn friction_twist(
         &mut self,
         laws: &FrictionLaws,

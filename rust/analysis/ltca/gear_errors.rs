@@ -16,11 +16,11 @@ use crate::dynamics::scene::Scene;
 #[cfg(test)]
 use std::f64::consts::TAU;
 
-/// One flank's error at a pose: value [m], gradient [m/rad] and Hessian [m/rad^2] by
+/// One flank's error at a pose: value \[m\], gradient [m/rad] and Hessian [m/rad^2] by
 /// (carrier, sun, crank) angles.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct FlankError {
-    /// Extra approach of the flank [m].
+    /// Extra approach of the flank \[m\].
     pub(crate) value: f64,
     grad: [f64; 3],
     hess: [[f64; 3]; 3],
@@ -28,7 +28,7 @@ pub(crate) struct FlankError {
 
 impl FlankError {
     /// The error of flank `sigma` (+1 drive, -1 coast) of mesh `i` at carrier angle `thc`,
-    /// sun angle `ths` and crank angle `alpha` [rad]; `None` without gear errors.
+    /// sun angle `ths` and crank angle `alpha` \[rad\]; `None` without gear errors.
     #[inline]
     pub(crate) fn at(
         errors: Option<&MeshErrors>,
@@ -63,7 +63,7 @@ impl FlankError {
         grad[2] += self.grad[2];
     }
 
-    /// Add the curvature term `f hess E` of the flank force `f` [N] to the tangent stiffness
+    /// Add the curvature term `f hess E` of the flank force `f` \[N\] to the tangent stiffness
     /// `K = -dQ/dx` (`Q = -f grad pen`, `pen` including `E`).
     #[inline]
     pub(crate) fn add_curvature(&self, kf: &mut Dense, ci: usize, f: f64) {

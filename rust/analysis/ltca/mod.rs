@@ -4,7 +4,7 @@
 //! worst-case contact loads for FEA (formulation and sources: docs/model.md, "Quasi-static
 //! analysis").
 //!
-//! Crank angle `psi` [rad]: the absolute crank rotation of the kinematic (unloaded, error-free)
+//! Crank angle `psi` \[rad\]: the absolute crank rotation of the kinematic (unloaded, error-free)
 //! pose, in which the carrier is at `-psi / zc`, disc `k`'s centre at
 //! `e (cos(psi + a_k), sin(psi + a_k))` and the input (sun, or cranks without a first stage)
 //! where the first stage has no deflection. The input is held there; the output torque `T`
@@ -28,41 +28,41 @@ use rayon::prelude::*;
 use serde::Serialize;
 use statics::{CARRIER, Statics, Work};
 
-/// One arc minute [rad].
+/// One arc minute \[rad\].
 pub const ARCMIN: f64 = PI / (180.0 * 60.0);
-/// One arc second [rad].
+/// One arc second \[rad\].
 pub const ARCSEC: f64 = PI / (180.0 * 3600.0);
 
 /// One pin contact at equilibrium (disc frame: origin at the disc centre, axes turned with the
 /// disc).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct PinLoad {
-    /// Normal force [N] (>= 0).
+    /// Normal force \[N\] (>= 0).
     pub force: f64,
-    /// Signed gap [m] (negative = penetration).
+    /// Signed gap \[m\] (negative = penetration).
     pub gap: f64,
-    /// Contact point on the profile, disc frame [m].
+    /// Contact point on the profile, disc frame \[m\].
     pub point: [f64; 2],
     /// Unit outward profile normal, disc frame.
     pub normal: [f64; 2],
-    /// Hertz half-width of the contact strip [m] (0 without load).
+    /// Hertz half-width of the contact strip \[m\] (0 without load).
     pub half_width: f64,
-    /// Hertz peak pressure [Pa] (0 without load).
+    /// Hertz peak pressure \[Pa\] (0 without load).
     pub peak_pressure: f64,
 }
 
 /// The static equilibrium at one crank angle and torque.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LtcaPoint {
-    /// Crank angle [rad].
+    /// Crank angle \[rad\].
     pub crank_angle: f64,
     /// Output torque [N m].
     pub torque: f64,
-    /// Carrier (output) angle [rad].
+    /// Carrier (output) angle \[rad\].
     pub output_angle: f64,
-    /// Held input angle [rad].
+    /// Held input angle \[rad\].
     pub input_angle: f64,
-    /// Transmission error `output - input / i` [rad].
+    /// Transmission error `output - input / i` \[rad\].
     pub transmission_error: f64,
     /// Torque the held input carries [N m].
     pub input_torque: f64,
@@ -70,15 +70,15 @@ pub struct LtcaPoint {
     pub pins: Vec<Vec<PinLoad>>,
     /// Loaded pins per disc.
     pub loaded_pins: Vec<usize>,
-    /// Disc rotation from its kinematic angle [rad], per disc.
+    /// Disc rotation from its kinematic angle \[rad\], per disc.
     pub disc_rotation: Vec<f64>,
-    /// Disc centre displacement from its kinematic position [m], per disc.
+    /// Disc centre displacement from its kinematic position \[m\], per disc.
     pub disc_displacement: Vec<[f64; 2]>,
-    /// Signed sun/planet mesh force per crank [N] (positive on the drive flank).
+    /// Signed sun/planet mesh force per crank \[N\] (positive on the drive flank).
     pub mesh_force: Vec<f64>,
-    /// Crank bearing force on each crank centre [N] (compliant crank bearings; else empty).
+    /// Crank bearing force on each crank centre \[N\] (compliant crank bearings; else empty).
     pub crank_bearing_force: Vec<[f64; 2]>,
-    /// Eccentric bearing force on each disc, `[crank * discs + disc]` [N] (compliant joints).
+    /// Eccentric bearing force on each disc, `[crank * discs + disc]` \[N\] (compliant joints).
     pub eccentric_bearing_force: Vec<[f64; 2]>,
     /// Moment balance of the whole reducer about its axis (input + load + pin reactions),
     /// relative to the torque.
@@ -93,7 +93,7 @@ pub struct LtcaPoint {
 }
 
 impl LtcaPoint {
-    /// Largest pin force [N] over both discs.
+    /// Largest pin force \[N\] over both discs.
     pub fn peak_pin_force(&self) -> f64 {
         self.pins
             .iter()
@@ -105,17 +105,17 @@ impl LtcaPoint {
 /// Transmission error over one mesh period in both drive directions.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TransmissionError {
-    /// Crank angles [rad] (one full mesh period, endpoint excluded).
+    /// Crank angles \[rad\] (one full mesh period, endpoint excluded).
     pub crank_angle: Vec<f64>,
-    /// Period of the mesh in crank angle [rad].
+    /// Period of the mesh in crank angle \[rad\].
     pub period: f64,
-    /// TE at `+torque` (forward drive) [rad].
+    /// TE at `+torque` (forward drive) \[rad\].
     pub forward: Vec<f64>,
-    /// TE at `-torque` (reverse drive) [rad].
+    /// TE at `-torque` (reverse drive) \[rad\].
     pub reverse: Vec<f64>,
-    /// TE at the light load `+light` [rad]: the geometric (unloaded) TE, forward.
+    /// TE at the light load `+light` \[rad\]: the geometric (unloaded) TE, forward.
     pub unloaded_forward: Vec<f64>,
-    /// TE at `-light` [rad]: the unloaded TE, reverse.
+    /// TE at `-light` \[rad\]: the unloaded TE, reverse.
     pub unloaded_reverse: Vec<f64>,
     /// Loaded torque [N m].
     pub torque: f64,
@@ -136,19 +136,19 @@ pub fn peak_to_peak(v: &[f64]) -> f64 {
 /// The torque-twist loop at one crank angle with rigidity, lost motion and backlash.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TwistLoop {
-    /// Crank angle of the loop [rad].
+    /// Crank angle of the loop \[rad\].
     pub crank_angle: f64,
     /// Output torque along the loop [N m] (0 -> +rated -> -rated -> 0).
     pub torque: Vec<f64>,
-    /// Output twist relative to the held input [rad] (positive with positive torque).
+    /// Output twist relative to the held input \[rad\] (positive with positive torque).
     pub twist: Vec<f64>,
     /// Rated torque of the loop [N m].
     pub rated_torque: f64,
     /// Catalogue torsional rigidity `2 T_r / (twist(+T_r) - twist(-T_r))` [N m/rad].
     pub rigidity: f64,
-    /// Lost motion: twist width between the loop's midpoints at +-3 % of rated torque [rad].
+    /// Lost motion: twist width between the loop's midpoints at +-3 % of rated torque \[rad\].
     pub lost_motion: f64,
-    /// Backlash: twist width at zero torque (limits from both sides) [rad].
+    /// Backlash: twist width at zero torque (limits from both sides) \[rad\].
     pub backlash: f64,
     /// Analytic tangent stiffness at each loop point [N m/rad].
     pub tangent_stiffness: Vec<f64>,
@@ -327,7 +327,7 @@ impl Ltca {
         })
     }
 
-    /// Period of the mesh in crank angle [rad] (see [`mesh_period`]).
+    /// Period of the mesh in crank angle \[rad\] (see [`mesh_period`]).
     pub fn mesh_period(&self) -> f64 {
         self.mesh_period
     }
@@ -409,7 +409,7 @@ impl Ltca {
         Ok((q, rep))
     }
 
-    /// The static equilibrium at crank angle `psi` [rad] under the output torque `torque`
+    /// The static equilibrium at crank angle `psi` \[rad\] under the output torque `torque`
     /// [N m]. Errors: non-finite input (`Parameter`); no equilibrium found or a penetration
     /// beyond a tenth of the pin radius (`Convergence`, naming the crank angle and residual).
     pub fn solve(&mut self, torque: f64, psi: f64) -> Result<LtcaPoint> {
@@ -860,7 +860,7 @@ impl Ltca {
     }
 }
 
-/// The crank-angle period after which the whole contact pattern repeats [rad].
+/// The crank-angle period after which the whole contact pattern repeats \[rad\].
 ///
 /// Turning the crank by `2 pi / zp` turns the disc by `-2 pi / (zp zc)`; the assembly then is
 /// the old one rotated by `2 pi / zp` about the axis (pin `j` takes the place of pin `j - 1`)

@@ -321,7 +321,7 @@ impl Scratch {
     }
 }
 
-/// Find the equilibrium at crank angle `psi` [rad] and output torque `torque` [N m] from the
+/// Find the equilibrium at crank angle `psi` \[rad\] and output torque `torque` [N m] from the
 /// guess `q` (overwritten with the solution). `k_ref` [N/m]: reference stiffness of the
 /// regularisation. With `capture`, on success `scratch.state` holds the contact state of an
 /// evaluation at the solution, and `work` (full forces) and `work.k_last` are that

@@ -132,9 +132,9 @@ impl Dense {
 /// What one evaluation found at every contact (fixed frame, SI).
 #[derive(Debug, Clone, Default)]
 pub struct ContactState {
-    /// Pin force [N] (>= 0) per disc and pin, at `k * pins + j`.
+    /// Pin force \[N\] (>= 0) per disc and pin, at `k * pins + j`.
     pub pin_force: Vec<f64>,
-    /// Signed gap [m] per disc and pin (negative = penetration).
+    /// Signed gap \[m\] per disc and pin (negative = penetration).
     pub pin_gap: Vec<f64>,
     /// The gap jets (contact point, normal, curvature) per disc and pin.
     pub pin_jet: Vec<GapJet>,
@@ -146,13 +146,13 @@ pub struct ContactState {
     /// for an isotropic law (force along the deflection); the roller laws, with their roller
     /// sets fixed in the frame, push slightly off the deflection.
     pub bearing_couple: f64,
-    /// Signed mesh force along the line of action per crank [N] (positive: drive flank).
+    /// Signed mesh force along the line of action per crank \[N\] (positive: drive flank).
     pub mesh_force: Vec<f64>,
-    /// Mesh deflection along the line of action per crank [m].
+    /// Mesh deflection along the line of action per crank \[m\].
     pub mesh_deflection: Vec<f64>,
-    /// Crank bearing force on each crank centre [N] (compliant crank bearings).
+    /// Crank bearing force on each crank centre \[N\] (compliant crank bearings).
     pub crank_bearing_force: Vec<[f64; 2]>,
-    /// Eccentric bearing force on each disc at `i * discs + k` [N].
+    /// Eccentric bearing force on each disc at `i * discs + k` \[N\].
     pub eccentric_bearing_force: Vec<[f64; 2]>,
 }
 
@@ -204,12 +204,12 @@ pub struct Statics {
     /// `ln` of each disc's body depth.
     ln_body_depth: Vec<f64>,
     seats: Vec<[f64; 2]>,
-    /// Actual crank seat of each crank in the carrier frame (with its position error) [m]:
+    /// Actual crank seat of each crank in the carrier frame (with its position error) \[m\]:
     /// the crank bearing's; the mesh keeps the nominal seat.
     seat_vecs: Vec<[f64; 2]>,
-    /// Eccentricity of each crank (with its error) [m].
+    /// Eccentricity of each crank (with its error) \[m\].
     ecc_radius: Vec<f64>,
-    /// Eccentric phase error of each crank [rad].
+    /// Eccentric phase error of each crank \[rad\].
     ecc_phase: Vec<f64>,
     holes: Vec<[f64; 2]>,
     /// `(sin, cos)` of the pressure angle.
@@ -220,7 +220,7 @@ pub struct Statics {
     pub scale: Vec<f64>,
     /// Foot parameter offset from the kinematic one per (disc, pin): the gap warm start.
     warm: Vec<f64>,
-    /// Largest contact penetration of the last evaluation [m].
+    /// Largest contact penetration of the last evaluation \[m\].
     pub max_penetration: f64,
     /// Number of evaluations so far (for benchmarks and reports).
     pub evaluations: usize,
@@ -243,9 +243,9 @@ pub struct Statics {
     /// `(cos, sin)` of each disc's angle at the current evaluation (the pins' and the
     /// eccentric bearings' one `sin_cos` per disc).
     disc_cs: Vec<[f64; 2]>,
-    /// Largest distance of a profile point from its disc centre [m].
+    /// Largest distance of a profile point from its disc centre \[m\].
     reach: f64,
-    /// Bound of each disc's profile error `|delta| <= bound` [m] (0 without one): the
+    /// Bound of each disc's profile error `|delta| <= bound` \[m\] (0 without one): the
     /// separation skip keeps `gap - bound` (the error-free gap less the bound is below the gap
     /// with the error, whatever the foot).
     error_bound: Vec<f64>,
@@ -417,7 +417,7 @@ impl Statics {
         })
     }
 
-    /// Secant stiffness `F(pen) / pen` [N/m] of the pin law at the approach `pen` [m] (the
+    /// Secant stiffness `F(pen) / pen` [N/m] of the pin law at the approach `pen` \[m\] (the
     /// stiffest place along a lobe of disc 0 for the line law): a reference stiffness for the
     /// solver's scaling.
     pub fn pin_secant_stiffness(&self, pen: f64) -> f64 {
@@ -467,7 +467,7 @@ impl Statics {
     }
 
     /// The held input angle (sun, or crank without a first stage) for the kinematic pose at
-    /// crank angle `psi` [rad]: `th_c = -psi / zc`, mesh deflection zero.
+    /// crank angle `psi` \[rad\]: `th_c = -psi / zc`, mesh deflection zero.
     pub fn held_input(&self, psi: f64) -> f64 {
         let thc = -psi / self.zc();
         match &self.model.mesh {
@@ -1123,7 +1123,7 @@ impl Statics {
         Ok(())
     }
 
-    /// A fresh [`Statics::eval`] at `q` into new buffers: the residual [N], the tangent and the
+    /// A fresh [`Statics::eval`] at `q` into new buffers: the residual \[N\], the tangent and the
     /// contact state. With `every_pin`, no pin is skipped by the separation bound (exact gaps
     /// of every pin, as a report needs).
     pub fn eval_fresh(
@@ -1248,7 +1248,7 @@ fn no_foot(k: usize, j: usize) -> RvdynError {
     ))
 }
 
-/// A disc profile error's offset `delta(phi)` [m] with its first and second derivatives
+/// A disc profile error's offset `delta(phi)` \[m\] with its first and second derivatives
 /// [m/rad, m/rad^2] (the table is piecewise linear: no second derivative between its points;
 /// at a point the slope jumps and the tangent is one-sided).
 fn profile_offset_jet(pe: &ProfileError, phi: f64) -> (f64, f64, f64) {
@@ -1297,8 +1297,8 @@ impl Default for Work {
     }
 }
 
-/// Elastic force [N] and its derivative [N/m] of an IMPACT contact law at penetration `pen`
-/// [m] (the laws [`Statics::new`] accepts).
+/// Elastic force \[N\] and its derivative [N/m] of an IMPACT contact law at penetration `pen`
+/// \[m\] (the laws [`Statics::new`] accepts).
 #[inline]
 pub fn elastic(law: &ImpactLaw, pen: f64) -> (f64, f64) {
     ContactLaw::Impact(*law).elastic_force_and_stiffness(pen)
@@ -1315,7 +1315,7 @@ struct MeshStatic {
     damping: f64,
 }
 
-/// The static law of a mesh flank at penetration `pen` [m] and mesh position `s` [m]: IMPACT
+/// The static law of a mesh flank at penetration `pen` \[m\] and mesh position `s` \[m\]: IMPACT
 /// (no dependence on `s`) or the ISO 6336 wave, `V = k(s) pen^2 / 2`: `F = k pen`,
 /// `V_s = k' pen^2 / 2`, `V_pen,s = k' pen`, `V_ss = k'' pen^2 / 2`.
 #[inline]
@@ -1348,7 +1348,7 @@ fn mesh_static(law: &MeshLaw, pen: f64, s: f64) -> MeshStatic {
     }
 }
 
-/// Damping coefficient [N s/m] of an IMPACT law at penetration `pen` [m] (at zero rate).
+/// Damping coefficient [N s/m] of an IMPACT law at penetration `pen` \[m\] (at zero rate).
 #[inline]
 pub fn contact_damping(law: &ImpactLaw, pen: f64) -> f64 {
     ContactLaw::Impact(*law).damping_coefficient(pen)

@@ -58,7 +58,7 @@ enum Extra {
 /// The operating point a linearisation was taken at.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Equilibrium {
-    /// Crank angle [rad].
+    /// Crank angle \[rad\].
     pub crank_angle: f64,
     /// Output torque [N m].
     pub torque: f64,
@@ -72,13 +72,13 @@ pub struct Equilibrium {
     pub iterations: usize,
     /// `|sum_p K_p - K|_F / |K|_F` of the stiffness split.
     pub split_error: f64,
-    /// Angles of the load and the motor [rad] (the carrier's and the sun's without shafts).
+    /// Angles of the load and the motor \[rad\] (the carrier's and the sun's without shafts).
     pub shaft_angles: [f64; 2],
     /// Full coordinates and velocities of the dynamic model at the operating point (its own
     /// layout: `[th_c, alpha, th_s, th_L, th_m]` for rigid joints, the compliant full vector
     /// otherwise); velocities zero at an equilibrium.
     pub dynamic_state: (Vec<f64>, Vec<f64>),
-    /// Time of the dynamic state [s] (0 for an equilibrium).
+    /// Time of the dynamic state \[s\] (0 for an equilibrium).
     pub time: f64,
 }
 
@@ -250,7 +250,7 @@ impl Linearizer {
         &self.mass
     }
 
-    /// The equilibrium at `crank_angle` [rad] under the output torque `torque` [N m]
+    /// The equilibrium at `crank_angle` \[rad\] under the output torque `torque` [N m]
     /// (warm-started from the last one). Errors: non-finite input (`Parameter`); no
     /// equilibrium (`Convergence`, from the LTCA, naming the crank angle and residual).
     pub fn equilibrium(&mut self, torque: f64, crank_angle: f64) -> Result<Equilibrium> {
@@ -324,7 +324,7 @@ impl Linearizer {
         }
     }
 
-    /// The operating point of a state `(q, v)` at time `t` [s] of a dynamic run of `scene`
+    /// The operating point of a state `(q, v)` at time `t` \[s\] of a dynamic run of `scene`
     /// (the scene this linearizer was built from): `q`, `v` in the run model's free
     /// coordinates (`ReducerModel::initial_state` order; rad, m, rad/s, m/s). The pose is
     /// taken as it is (no equilibrium is solved): the held input at its angle at `t`, the
@@ -405,7 +405,7 @@ impl Linearizer {
         })
     }
 
-    /// Linearise about the equilibrium at `crank_angle` [rad] and output torque `torque`
+    /// Linearise about the equilibrium at `crank_angle` \[rad\] and output torque `torque`
     /// [N m]: the system `(M, K parts, C)` and the equilibrium it was taken at.
     pub fn linearise(
         &mut self,

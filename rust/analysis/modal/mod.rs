@@ -56,7 +56,7 @@ pub struct LinearSystem {
     pub stiffness: Vec<StiffnessPart>,
     /// Damping matrix, n x n (zeros for an undamped analysis).
     pub damping: DMatrix<f64>,
-    /// Length per unit of each coordinate [m] (a lever arm for an angle), used only to pick
+    /// Length per unit of each coordinate \[m\] (a lever arm for an angle), used only to pick
     /// the dominant coordinate of a mode shape; empty = all 1.
     pub length_scale: Vec<f64>,
 }
@@ -67,9 +67,9 @@ pub struct DampedMode {
     /// Eigenvalue of the state matrix [1/s] (the one with positive imaginary part; for an
     /// overdamped pair the slower real root).
     pub eigenvalue: Complex<f64>,
-    /// Undamped natural frequency of the damped eigenvalue(s), `|lambda| / 2 pi` [Hz].
+    /// Undamped natural frequency of the damped eigenvalue(s), `|lambda| / 2 pi` \[Hz\].
     pub natural_frequency: f64,
-    /// Damped frequency `Im(lambda) / 2 pi` [Hz] (0 for an overdamped mode).
+    /// Damped frequency `Im(lambda) / 2 pi` \[Hz\] (0 for an overdamped mode).
     pub damped_frequency: f64,
     /// Damping ratio (dimensionless; >= 1 for an overdamped pair).
     pub damping_ratio: f64,
@@ -85,7 +85,7 @@ pub struct DampedMode {
 pub struct Mode {
     /// `w^2` [1/s^2] (negative: a statically unstable direction of the tangent stiffness).
     pub omega_squared: f64,
-    /// Undamped natural frequency `sqrt(max(w^2, 0)) / 2 pi` [Hz].
+    /// Undamped natural frequency `sqrt(max(w^2, 0)) / 2 pi` \[Hz\].
     pub frequency: f64,
     /// A rigid-body (zero-stiffness) mode: `|w^2|` below 1e-10 of the largest.
     pub rigid_body: bool,
@@ -129,7 +129,7 @@ pub struct ModalAnalysis {
 }
 
 impl ModalAnalysis {
-    /// Lowest and highest undamped natural frequency of the non-rigid modes [Hz].
+    /// Lowest and highest undamped natural frequency of the non-rigid modes \[Hz\].
     pub fn frequency_span(&self) -> (f64, f64) {
         let f: Vec<f64> = self
             .modes
@@ -143,7 +143,7 @@ impl ModalAnalysis {
         )
     }
 
-    /// Indices of the modes whose undamped frequency lies in `[lo, hi]` [Hz]. A range that is
+    /// Indices of the modes whose undamped frequency lies in `[lo, hi]` \[Hz\]. A range that is
     /// not finite, not ordered, negative, or holds no mode of the model is a `ParameterError`
     /// that gives the model's frequency span.
     pub fn modes_in_range(&self, lo: f64, hi: f64) -> Result<Vec<usize>> {

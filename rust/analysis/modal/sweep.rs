@@ -21,7 +21,7 @@ pub struct ModalPoint {
     pub damping: Vec<f64>,
 }
 
-/// Modes of `scene` about its equilibrium at `crank_angle` [rad] under the output torque
+/// Modes of `scene` about its equilibrium at `crank_angle` \[rad\] under the output torque
 /// `torque` [N m].
 pub fn modes_at(lin: &mut Linearizer, torque: f64, crank_angle: f64) -> Result<ModalPoint> {
     let (sys, eq) = lin.linearise(torque, crank_angle)?;
@@ -58,7 +58,7 @@ pub struct Campbell {
     pub speeds: Vec<f64>,
     /// Output torque at each speed [N m].
     pub torques: Vec<f64>,
-    /// Undamped natural frequency [Hz], `[speed][mode]`.
+    /// Undamped natural frequency \[Hz\], `[speed][mode]`.
     pub frequencies: Vec<Vec<f64>>,
     /// Damping ratio of the matched damped eigenvalue (the modal estimate when unmatched),
     /// `[speed][mode]`.
@@ -71,9 +71,9 @@ pub struct Campbell {
     pub crossings: Vec<Crossing>,
 }
 
-/// The Campbell diagram of `scene` at the crank angle `crank_angle` [rad]: at each input speed
+/// The Campbell diagram of `scene` at the crank angle `crank_angle` \[rad\]: at each input speed
 /// `speeds[s]` [rad/s] (increasing) the modes about the equilibrium under `torques[s]` [N m];
-/// the modes in `frequency_range` [Hz] (at the first speed; all if `None`) are kept, and the
+/// the modes in `frequency_range` \[Hz\] (at the first speed; all if `None`) are kept, and the
 /// crossings of each excitation order (pin-pass and sun-mesh harmonics up to `harmonics`) with
 /// them returned. The speed enters only through the torque (the models have no gyroscopic
 /// or speed-dependent terms: constant masses in planar absolute or reduced coordinates).
@@ -137,7 +137,7 @@ pub fn campbell(
     })
 }
 
-/// Modes of `scene` about the state `(q, v)` at time `t` [s] of a dynamic run (the run
+/// Modes of `scene` about the state `(q, v)` at time `t` \[s\] of a dynamic run (the run
 /// model's free coordinates and velocities, `ReducerModel::initial_state` order), with the
 /// linearizer `lin` built from the same scene (see [`Linearizer::state_point`]).
 pub fn modes_at_state(

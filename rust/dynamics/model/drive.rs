@@ -6,9 +6,9 @@ use crate::dynamics::scene::{Drive, StartKind};
 /// Time law of the input.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum DriveProfile {
-    /// Prescribed speed [rad/s], reached at once (`ramp = None`) or over a cubic ramp [s].
+    /// Prescribed speed [rad/s], reached at once (`ramp = None`) or over a cubic ramp \[s\].
     Speed { speed: f64, ramp: Option<f64> },
-    /// Prescribed torque [N m], ramped over `ramp` [s] (0 = step).
+    /// Prescribed torque [N m], ramped over `ramp` \[s\] (0 = step).
     Torque { torque: f64, ramp: f64 },
 }
 
@@ -44,7 +44,7 @@ impl DriveProfile {
         }
     }
 
-    /// Prescribed (angle [rad], speed [rad/s], acceleration [rad/s^2]) at time `t` [s].
+    /// Prescribed (angle \[rad\], speed [rad/s], acceleration [rad/s^2]) at time `t` \[s\].
     /// The ramp `w(t) = W s^2 (3 - 2 s)`, `s = t/T`, integrates to `W T (s^3 - s^4/2)`.
     pub(crate) fn motion(&self, t: f64) -> (f64, f64, f64) {
         match *self {

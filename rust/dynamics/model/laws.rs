@@ -8,7 +8,7 @@ use crate::dynamics::model::vec2::dot;
 use crate::dynamics::scene::{Bearing, ContactLawSpec};
 use crate::error::Result;
 
-/// The normal force law of a contact with penetration `x` [m] and penetration rate [m/s].
+/// The normal force law of a contact with penetration `x` \[m\] and penetration rate [m/s].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ContactLaw {
     /// `F = k x^e + STEP(x, 0, 0, d, cmax) xdot`, `F >= 0` (ADAMS IMPACT; the Palmgren line
@@ -17,12 +17,12 @@ pub enum ContactLaw {
 }
 
 impl ContactLaw {
-    /// The law a scene specifies for a contact of length `face_width` [m].
+    /// The law a scene specifies for a contact of length `face_width` \[m\].
     pub fn from_spec(spec: &ContactLawSpec, face_width: f64) -> Result<Self> {
         Ok(ContactLaw::Impact(spec.law(face_width)?))
     }
 
-    /// Normal force [N] (>= 0) at penetration `x` [m] (> 0) and rate `rate` [m/s].
+    /// Normal force \[N\] (>= 0) at penetration `x` \[m\] (> 0) and rate `rate` [m/s].
     #[inline]
     pub fn force(&self, x: f64, rate: f64) -> f64 {
         match self {
@@ -30,7 +30,7 @@ impl ContactLaw {
         }
     }
 
-    /// The elastic (conservative) part of the force [N].
+    /// The elastic (conservative) part of the force \[N\].
     #[inline]
     pub fn elastic_force(&self, x: f64) -> f64 {
         match self {
@@ -38,7 +38,7 @@ impl ContactLaw {
         }
     }
 
-    /// Elastic energy stored at penetration `x` [J].
+    /// Elastic energy stored at penetration `x` \[J\].
     #[inline]
     pub fn elastic_energy(&self, x: f64) -> f64 {
         match self {
@@ -46,8 +46,8 @@ impl ContactLaw {
         }
     }
 
-    /// Elastic force [N] and its derivative, the static contact stiffness [N/m], at penetration
-    /// `x` [m] (both 0 for `x <= 0`): the contact's part of the tangent stiffness (quasi-static
+    /// Elastic force \[N\] and its derivative, the static contact stiffness [N/m], at penetration
+    /// `x` \[m\] (both 0 for `x <= 0`): the contact's part of the tangent stiffness (quasi-static
     /// analysis and modes).
     #[inline]
     pub fn elastic_force_and_stiffness(&self, x: f64) -> (f64, f64) {
@@ -62,7 +62,7 @@ impl ContactLaw {
         }
     }
 
-    /// Damping coefficient `dF/dx'` [N s/m] at penetration `x` [m] and zero rate (0 for
+    /// Damping coefficient `dF/dx'` [N s/m] at penetration `x` \[m\] and zero rate (0 for
     /// `x <= 0`): the contact's part of the linearised damping matrix.
     #[inline]
     pub fn damping_coefficient(&self, x: f64) -> f64 {
@@ -74,9 +74,9 @@ impl ContactLaw {
         }
     }
 
-    /// A mesh with total backlash `backlash` [m] along the line of action at deflection
-    /// `delta` [m] (positive on the drive flank) and rate `rate` [m/s]: the signed force [N]
-    /// (negative on the coast flank), its signed elastic part, the penetration [m] (0 inside
+    /// A mesh with total backlash `backlash` \[m\] along the line of action at deflection
+    /// `delta` \[m\] (positive on the drive flank) and rate `rate` [m/s]: the signed force \[N\]
+    /// (negative on the coast flank), its signed elastic part, the penetration \[m\] (0 inside
     /// the backlash) and the penetration rate [m/s].
     #[inline]
     pub fn mesh(&self, backlash: f64, delta: f64, rate: f64) -> (f64, f64, f64, f64) {
@@ -96,12 +96,12 @@ impl ContactLaw {
 /// Force of one bearing and its energy flows.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct BearingLoad {
-    /// Force on the body at the `+` end of the deflection `d` [N] (the other body gets the
+    /// Force on the body at the `+` end of the deflection `d` \[N\] (the other body gets the
     /// opposite).
     pub force: [f64; 2],
-    /// Power dissipated by the damper [W] (>= 0).
+    /// Power dissipated by the damper \[W\] (>= 0).
     pub dissipation: f64,
-    /// Elastic energy of the spring [J].
+    /// Elastic energy of the spring \[J\].
     pub energy: f64,
 }
 
@@ -112,11 +112,11 @@ pub enum BearingLaw {
     /// `F = (k pen + c pen') n` (>= 0) beyond it.
     Linear(Bearing),
     /// Roller bearing built from its rollers (`bearing::RollerBearing`, Palmgren per roller)
-    /// with per-roller stiffness-proportional damping `beta` [s].
+    /// with per-roller stiffness-proportional damping `beta` \[s\].
     Rollers {
         /// The rollers and the clearance.
         bearing: crate::bearing::RollerBearing,
-        /// Damping factor of each roller [s].
+        /// Damping factor of each roller \[s\].
         beta: f64,
         /// The scene bearing: its `stiffness` and `damping` act in parallel (0 for none).
         parallel: Bearing,
@@ -136,7 +136,7 @@ impl BearingLaw {
         })
     }
 
-    /// The load for a deflection `d` [m] and its rate `dd` [m/s].
+    /// The load for a deflection `d` \[m\] and its rate `dd` [m/s].
     #[inline]
     pub fn load(&self, d: [f64; 2], dd: [f64; 2]) -> BearingLoad {
         match self {
@@ -165,8 +165,8 @@ impl BearingLaw {
 }
 
 impl BearingLaw {
-    /// Static tangent of the bearing at deflection `d` [m] and zero rate: the gradient of its
-    /// potential `dV/dd` [N] (minus the force on the `+` body) and its Hessian `hess_d V`
+    /// Static tangent of the bearing at deflection `d` \[m\] and zero rate: the gradient of its
+    /// potential `dV/dd` \[N\] (minus the force on the `+` body) and its Hessian `hess_d V`
     /// [N/m]: `F n` and `F' n n^T + (F/|d|)(I - n n^T)` for the radial law `F(|d| - c)` along
     /// `n = d/|d|`, `k d` and `k I` without clearance (docs/model.md, quasi-static analysis).
     #[inline]

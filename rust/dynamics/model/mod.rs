@@ -36,11 +36,11 @@ pub struct Layout {
 /// Everything recorded about the bodies at one instant (SI, fixed frame).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Observation {
-    /// Sun (input) angle [rad].
+    /// Sun (input) angle \[rad\].
     pub sun_angle: f64,
     /// Sun speed [rad/s].
     pub sun_speed: f64,
-    /// Carrier (output) angle [rad].
+    /// Carrier (output) angle \[rad\].
     pub carrier_angle: f64,
     /// Carrier speed [rad/s].
     pub carrier_speed: f64,
@@ -48,23 +48,23 @@ pub struct Observation {
     pub crank_angle: Vec<f64>,
     /// Absolute speed of each crankshaft [rad/s].
     pub crank_speed: Vec<f64>,
-    /// Disc centres [m].
+    /// Disc centres \[m\].
     pub disc_center: Vec<[f64; 2]>,
-    /// Disc rotation angles [rad].
+    /// Disc rotation angles \[rad\].
     pub disc_angle: Vec<f64>,
     /// Torque the drive applies to the input [N m].
     pub input_torque: f64,
-    /// Kinetic energy of the free bodies [J].
+    /// Kinetic energy of the free bodies \[J\].
     pub kinetic_energy: f64,
-    /// Elastic energy of the contacts and bearings [J].
+    /// Elastic energy of the contacts and bearings \[J\].
     pub potential_energy: f64,
-    /// Friction power [W] at the pins, the teeth and the bearings.
+    /// Friction power \[W\] at the pins, the teeth and the bearings.
     pub friction_power: [f64; 3],
-    /// Load angle [rad] (the carrier's without an output shaft).
+    /// Load angle \[rad\] (the carrier's without an output shaft).
     pub load_angle: f64,
     /// Load speed [rad/s].
     pub load_speed: f64,
-    /// Motor angle [rad] (the input's without a drive shaft).
+    /// Motor angle \[rad\] (the input's without a drive shaft).
     pub motor_angle: f64,
     /// Motor speed [rad/s].
     pub motor_speed: f64,
@@ -72,7 +72,7 @@ pub struct Observation {
     pub output_shaft_torque: f64,
     /// Torque in the drive shaft [N m] (without one: the input torque).
     pub input_shaft_torque: f64,
-    /// Power flows `[input, output, dissipated]` [W], as `MechanicalSystem::eval` gives them
+    /// Power flows `[input, output, dissipated]` \[W\], as `MechanicalSystem::eval` gives them
     /// at this state (zero when the sink wants no forces).
     pub power: [f64; 3],
 }

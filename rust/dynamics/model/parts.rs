@@ -14,15 +14,15 @@ use crate::geometry::mass::{DiscHoles, MassProperties, disc_mass_properties, sol
 #[derive(Debug, Clone)]
 pub(crate) struct DiscModel {
     pub(crate) geometry: CycloidGeometry,
-    /// Eccentric phase on the crank [rad].
+    /// Eccentric phase on the crank \[rad\].
     pub(crate) phase: f64,
-    /// Disc angle offset from the carrier angle, `-phase / zc` [rad].
+    /// Disc angle offset from the carrier angle, `-phase / zc` \[rad\].
     pub(crate) angle_offset: f64,
     /// Cosine and sine of `phase` and of `angle_offset`: a disc's pose turns the crank's and
     /// the carrier's by them (the trigonometry of an evaluation is then shared by the discs).
     pub(crate) phase_cs: [f64; 2],
     pub(crate) offset_cs: [f64; 2],
-    /// Body depth of the disc for the line contact law [m]: pin circle radius minus pin
+    /// Body depth of the disc for the line contact law \[m\]: pin circle radius minus pin
     /// radius (about the distance from the disc centre to a contact).
     pub(crate) body_depth: f64,
     /// Profile error (normal offset of the ground profile), `None` when there is none.
@@ -34,7 +34,7 @@ pub(crate) struct DiscModel {
 pub(crate) struct PinModel {
     pub(crate) centre: [f64; 2],
     pub(crate) radius: f64,
-    /// Nominal angle of the pin on the pin circle [rad] (the kinematic seed of its contact).
+    /// Nominal angle of the pin on the pin circle \[rad\] (the kinematic seed of its contact).
     pub(crate) angle: f64,
 }
 
@@ -43,13 +43,13 @@ pub(crate) struct PinModel {
 pub(crate) struct MeshModel {
     pub(crate) sun_base_radius: f64,
     pub(crate) planet_base_radius: f64,
-    /// Total backlash along the line of action [m].
+    /// Total backlash along the line of action \[m\].
     pub(crate) backlash: f64,
     pub(crate) law: MeshLaw,
     pub(crate) count: usize,
     /// Mesh phase of each planet, fraction of a base pitch (`gear::planet_mesh_phases`).
     pub(crate) phases: [f64; MAX_PLANETS],
-    /// Base pitch [m].
+    /// Base pitch \[m\].
     pub(crate) base_pitch: f64,
     /// Path of contact for tooth friction.
     pub(crate) path: ToothPath,
@@ -86,9 +86,9 @@ pub struct Parts {
     pub(crate) mesh: Option<MeshModel>,
     /// Number of crankshafts.
     pub(crate) cranks: usize,
-    /// Distance of the crank axes from the reducer axis [m].
+    /// Distance of the crank axes from the reducer axis \[m\].
     pub(crate) crank_radius: f64,
-    /// Eccentricity [m].
+    /// Eccentricity \[m\].
     pub(crate) eccentricity: f64,
     /// Mass properties used.
     pub(crate) inertias: ModelInertias,
@@ -100,9 +100,9 @@ pub struct Parts {
     pub(crate) ratio: f64,
     /// Initial state.
     pub(crate) initial: Initial,
-    /// Penetration beyond which a run is declared unstable [m].
+    /// Penetration beyond which a run is declared unstable \[m\].
     pub(crate) max_penetration: f64,
-    /// Largest distance of a profile point from its disc centre [m].
+    /// Largest distance of a profile point from its disc centre \[m\].
     pub(crate) profile_reach: f64,
     /// Output shaft between the carrier and the load inertia (`None`: rigid).
     pub(crate) output_shaft: Option<Shaft>,
@@ -263,7 +263,7 @@ impl Parts {
         }
     }
 
-    /// Torques of the output and drive shafts at `t` from (angle [rad], speed [rad/s]) of
+    /// Torques of the output and drive shafts at `t` from (angle \[rad\], speed [rad/s]) of
     /// the carrier, the reducer input (sun), the load and the motor (docs/model.md#machine-shafts).
     pub(crate) fn shaft_loads(
         &self,
@@ -381,9 +381,9 @@ pub(crate) struct ShaftLoads {
     pub(crate) output_torque: f64,
     /// Torque in the drive shaft, `k_i (th_m - th_s) + c_i (w_m - w_s)` [N m].
     pub(crate) input_torque: f64,
-    /// Elastic energy of the shafts [J].
+    /// Elastic energy of the shafts \[J\].
     pub(crate) potential: f64,
-    /// Power dissipated by the shaft damping [W].
+    /// Power dissipated by the shaft damping \[W\].
     pub(crate) dissipation: f64,
 }
 
@@ -393,7 +393,7 @@ pub(crate) struct ShaftLoads {
 pub(crate) struct MeshErrors {
     sun: GearModelError,
     planets: Vec<GearModelError>,
-    /// Angle of each planet on the carrier [rad].
+    /// Angle of each planet on the carrier \[rad\].
     gamma: Vec<f64>,
     pressure_angle: f64,
     cos_pa: f64,
@@ -426,7 +426,7 @@ impl GearModelError {
         }
     }
 
-    /// Cumulative pitch deviation [m] and its slope [m/rad] at body angle `psi`.
+    /// Cumulative pitch deviation \[m\] and its slope [m/rad] at body angle `psi`.
     fn pitch(&self, psi: f64) -> (f64, f64) {
         let (s, c) = (psi + self.pitch_phase).sin_cos();
         let (t, ts) = crate::geometry::cycloid::periodic_table(&self.table, psi);
@@ -440,7 +440,7 @@ impl GearModelError {
     }
 }
 
-/// Extra approach of one mesh flank [m] and its derivatives by the carrier, sun and crank
+/// Extra approach of one mesh flank \[m\] and its derivatives by the carrier, sun and crank
 /// angles [m/rad].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct MeshOffset {
@@ -479,7 +479,7 @@ impl MeshErrors {
     }
 
     /// Extra approach of flank `sign` (+1 drive, -1 coast) of mesh `i` at carrier angle
-    /// `thc`, sun angle `ths` and absolute crank angle `alpha` [rad]:
+    /// `thc`, sun angle `ths` and absolute crank angle `alpha` \[rad\]:
     /// `E = sign cos(pa) (F_s(th_c + g_i - th_s) + F_p(th_c + g_i + pi - alpha))
     /// + e_s cos(th_s + p_s - psi) - e_p cos(alpha + p_p - psi)`, with
     /// `psi = th_c + g_i + sign (pi/2 - pa)` the direction of the flank's line of action.
@@ -586,7 +586,7 @@ mod tests {
         Some(ProfileError { harmonics, table })
     }
 
-    /// Penetration of every pin into disc 0 at the kinematic pose turned by `turn` [rad].
+    /// Penetration of every pin into disc 0 at the kinematic pose turned by `turn` \[rad\].
     fn penetrations(scene: &Scene, turn: f64) -> Vec<(f64, f64)> {
         let p = Parts::new(scene).unwrap();
         let d = &p.discs[0];
@@ -627,7 +627,7 @@ mod tests {
         }
     }
 
-    /// Exact signed gap of a pin (centre `c` [m], radius `r`) to the offset profile
+    /// Exact signed gap of a pin (centre `c` \[m\], radius `r`) to the offset profile
     /// `P(phi) + delta(phi) n(phi)` of disc `g` (disc frame, no rotation modification) by a
     /// dense scan and golden-section refinement around `phi0`: independent of the model's
     /// first-order formula.

@@ -7,7 +7,7 @@ use crate::error::{Result, RvdynError};
 use crate::geometry::gap::{FootOrOpen, small_sin_cos};
 use std::cell::Cell;
 
-/// Where a disc is: centre [m], angle [rad] and the angle's sine and cosine (computed once per
+/// Where a disc is: centre \[m\], angle \[rad\] and the angle's sine and cosine (computed once per
 /// disc, not once per pin).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct DiscPose {
@@ -40,14 +40,14 @@ pub(crate) struct WarmStart {
     /// `ln F` of the line law's force at that evaluation (its inversion's warm start; NaN
     /// when unknown).
     pub(crate) ln_force: f64,
-    /// Signed gap [m] at that evaluation (`+inf` before the first).
+    /// Signed gap \[m\] at that evaluation (`+inf` before the first).
     pub(crate) gap: f64,
     /// The gap at the last accepted step end ([`mark_open`]): a pin open there that touches
     /// at the next evaluation closed within the step.
     pub(crate) marked_gap: f64,
 }
 
-/// The depth [m] a first touch may reach within one integrator step under `law`: the IMPACT
+/// The depth \[m\] a first touch may reach within one integrator step under `law`: the IMPACT
 /// law's damping ramp `d` (a step that closes deeper jumps the damping from 0 to `cmax`, the
 /// failure a ramp exists to prevent). `None` for laws whose force and damping rise
 /// continuously from zero approach (the line law), where the error estimate covers first touch.
@@ -87,7 +87,7 @@ pub(crate) fn mark_open(seeds: &[Cell<WarmStart>]) {
     }
 }
 
-/// The deepest first touch since [`mark_open`], over `allowed` [m]: the largest penetration of
+/// The deepest first touch since [`mark_open`], over `allowed` \[m\]: the largest penetration of
 /// a pin open at the mark and touching at the last evaluation, divided by `allowed`, with the
 /// pin's index (disc-major, as the seeds). `None` if no pin closed.
 pub(crate) fn deepest_first_touch(seeds: &[Cell<WarmStart>], allowed: f64) -> Option<(f64, usize)> {
@@ -121,13 +121,13 @@ impl Default for WarmStart {
 /// A pin in contact with a disc (fixed frame, SI).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct PinContact {
-    /// Penetration [m] (> 0).
+    /// Penetration \[m\] (> 0).
     pub(crate) penetration: f64,
     /// Unit outward profile normal (from the disc towards the pin).
     pub(crate) normal: [f64; 2],
-    /// Contact point on the profile relative to the disc centre [m].
+    /// Contact point on the profile relative to the disc centre \[m\].
     pub(crate) arm: [f64; 2],
-    /// Curve parameter of the contact on the profile [rad] (for laws that need the local
+    /// Curve parameter of the contact on the profile \[rad\] (for laws that need the local
     /// curvature).
     pub(crate) phi: f64,
     /// With a profile error `delta(phi)`: the derivatives of its share of the penetration,
@@ -146,7 +146,7 @@ impl PinContact {
 }
 
 impl PinContact {
-    /// `arm x normal` (z): the lever of the normal about the disc centre [m].
+    /// `arm x normal` (z): the lever of the normal about the disc centre \[m\].
     #[inline]
     pub(crate) fn lever(&self) -> f64 {
         self.arm[0] * self.normal[1] - self.arm[1] * self.normal[0]
@@ -179,15 +179,16 @@ pub(crate) fn pin_query(
 }
 
 /// What [`pin_query_or_open`] found: the exact contact, or a pin shown open with a lower
-/// bound of its gap [m].
+/// bound of its gap \[m\].
 pub(crate) enum PinQuery {
     Contact(PinContact),
     Open(f64),
 }
 
-/// [`pin_query`], or [`PinQuery::Open`] with a lower bound of the gap when `open_test` is set
-/// and the pin is shown open at the seed, from its last exact gap carried along the disc's rotation
-/// ([`CycloidGeometry::contact_foot_or_open`]: the seed is the last foot turned with the disc,
+/// The exact pin query (as `pin_query`), or [`PinQuery::Open`] with a lower bound of the gap
+/// when `open_test` is set and the pin is shown open at the seed, from its last exact gap
+/// carried along the disc's rotation
+/// ([`crate::geometry::CycloidGeometry::contact_foot_or_open`]: the seed is the last foot turned with the disc,
 /// and the pin keeps its place relative to a conjugate profile, so the test stays tight while
 /// the disc moves farther than the gap, where [`SeparationBound`] cannot skip). The warm start
 /// then moves to the seed and keeps its gap (a lower bound is all the test needs). Rigid
@@ -295,7 +296,7 @@ pub(crate) fn pin_query_or_open(
     }))
 }
 
-/// Round-off allowance of the open test of [`pin_query_or_open`] [m] (the seed's curve point
+/// Round-off allowance of the open test of [`pin_query_or_open`] \[m\] (the seed's curve point
 /// and normal carry about 1e-16 of the pin circle radius).
 const OPEN_SLACK: f64 = 1e-12;
 
@@ -334,7 +335,7 @@ impl Default for SeparationBound {
 }
 
 impl SeparationBound {
-    /// Whether the pin provably cannot touch the disc at centre `o` [m], angle `th` [rad].
+    /// Whether the pin provably cannot touch the disc at centre `o` \[m\], angle `th` \[rad\].
     #[inline]
     pub(crate) fn separated(&self, o: [f64; 2], th: f64, reach: f64) -> bool {
         let (dx, dy) = (o[0] - self.centre[0], o[1] - self.centre[1]);
@@ -396,7 +397,7 @@ pub(crate) fn touching_pin(
     Ok(Some(pc))
 }
 
-/// The force of `law` on a touching pin at `site` (approach `pen` [m], rate `rate` [m/s]), as
+/// The force of `law` on a touching pin at `site` (approach `pen` \[m\], rate `rate` [m/s]), as
 /// [`PinLaw::evaluate`]; a line law's inversion starts from the `ln F` this pin had at the
 /// previous evaluation (kept in `warm`), which saves Newton iterations and not accuracy.
 #[inline]

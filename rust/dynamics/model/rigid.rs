@@ -42,19 +42,19 @@ pub(crate) struct Forces {
     /// Generalised forces on `[th_c, alpha, th_s]` [N m] (the shafts' on the load and motor
     /// are added by the adapter).
     pub(crate) q: [f64; 3],
-    /// Power dissipated by contact damping [W].
+    /// Power dissipated by contact damping \[W\].
     pub(crate) dissipation: f64,
-    /// Elastic energy stored in the contacts [J] (only when asked for).
+    /// Elastic energy stored in the contacts \[J\] (only when asked for).
     pub(crate) potential: f64,
-    /// Friction power [W] (>= 0; part of `dissipation`) per family: pin/disc (or pin/housing
+    /// Friction power \[W\] (>= 0; part of `dissipation`) per family: pin/disc (or pin/housing
     /// for rolling pins), sun/planet teeth, bearings.
     pub(crate) friction: [f64; 3],
-    /// Net load of the pins on each disc (at most 2): force [N] on the centre (fixed frame) and
+    /// Net load of the pins on each disc (at most 2): force \[N\] on the centre (fixed frame) and
     /// moment [N m] about it, friction and location terms included (for the joint reactions).
     pub(crate) disc_load: [[f64; 3]; 2],
 }
 
-/// The rigid-joint reducer model: the shared [`Parts`] plus its coordinates.
+/// The rigid-joint reducer model: the shared `Parts` plus its coordinates.
 #[derive(Debug, Clone)]
 pub struct RigidModel {
     /// Geometry, laws, inertias, drive and load (shared with the compliant model).
@@ -206,7 +206,7 @@ impl RigidModel {
         }
     }
 
-    /// Disc `k` centre [m] and angle [rad] for the full coordinates `x` (as the force
+    /// Disc `k` centre \[m\] and angle \[rad\] for the full coordinates `x` (as the force
     /// evaluation places it; for tests).
     #[cfg(test)]
     pub(crate) fn disc_pose(&self, k: usize, x: &[f64; 3]) -> ([f64; 2], f64) {
@@ -217,7 +217,7 @@ impl RigidModel {
         )
     }
 
-    /// The centre [m] of disc `d` from the sine and cosine of the crank angle, turned by the
+    /// The centre \[m\] of disc `d` from the sine and cosine of the crank angle, turned by the
     /// disc's phase (one `sin_cos` per evaluation instead of one per disc).
     #[inline]
     pub(crate) fn disc_centre(&self, d: &DiscModel, (sa, ca): (f64, f64)) -> [f64; 2] {
@@ -463,7 +463,7 @@ impl RigidModel {
         Ok(out)
     }
 
-    /// Reactions of the ideal eccentric bearings on the discs [N], at `i * discs + k` (crank
+    /// Reactions of the ideal eccentric bearings on the discs \[N\], at `i * discs + k` (crank
     /// `i`, disc `k`; fixed frame), from each disc's balance with the pins at the state
     /// `(x, v)` with accelerations `a` (docs/model.md#bearing-reactions-of-ideal-joints): the net
     /// reaction `R = m_d O'' - F_pins` and moment `M = J_d theta'' - M_pins` split over the
@@ -501,7 +501,7 @@ impl RigidModel {
         out
     }
 
-    /// Reactions of the ideal crank (main) bearings on the cranks [N] (fixed frame), from each
+    /// Reactions of the ideal crank (main) bearings on the cranks \[N\] (fixed frame), from each
     /// crank's balance (docs/model.md#bearing-reactions-of-ideal-joints):
     /// `B_i = m_cr p_i'' + sum_k R_ik - F_mesh,i`, with the crank centre's acceleration
     /// `p_i'' = r_cr ((z x u_i) th_c'' - u_i th_c'^2)` (`u_i` the crank's direction; the
@@ -552,7 +552,7 @@ impl RigidModel {
             .collect()
     }
 
-    /// Kinetic energy of the free bodies [J] (the prescribed input is a driver, not counted).
+    /// Kinetic energy of the free bodies \[J\] (the prescribed input is a driver, not counted).
     pub(crate) fn kinetic_energy(&self, v: &[f64; FULL]) -> f64 {
         (0..FULL)
             .filter(|i| {

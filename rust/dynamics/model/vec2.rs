@@ -18,7 +18,7 @@ pub fn perp(a: [f64; 2]) -> [f64; 2] {
     [-a[1], a[0]]
 }
 
-/// `a` turned by `angle` [rad].
+/// `a` turned by `angle` \[rad\].
 #[inline]
 pub fn rotate(angle: f64, a: [f64; 2]) -> [f64; 2] {
     let (s, c) = angle.sin_cos();

@@ -19,20 +19,20 @@ pub const MAX_STEPS: f64 = 1e10;
 /// Options of one run (SI).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimOptions {
-    /// End time [s].
+    /// End time \[s\].
     pub t_end: f64,
     /// The integrator (a registry entry).
     pub method: Method,
-    /// Step [s] of the fixed-step methods; initial step of the adaptive one. `None` = default.
+    /// Step \[s\] of the fixed-step methods; initial step of the adaptive one. `None` = default.
     pub dt: Option<f64>,
     /// Relative tolerance (adaptive method, velocities).
     pub rtol: f64,
-    /// Absolute displacement tolerance [m]: the error control of the adaptive method, and the
+    /// Absolute displacement tolerance \[m\]: the error control of the adaptive method, and the
     /// Newton tolerance of generalized-alpha.
     pub atol: f64,
     /// Spectral radius at infinity of generalized-alpha.
     pub rho_inf: f64,
-    /// Sample interval [s]; `None` = the default (1e-4 s, coarsened to fit `max_samples`).
+    /// Sample interval \[s\]; `None` = the default (1e-4 s, coarsened to fit `max_samples`).
     pub record_interval: Option<f64>,
     /// Largest number of samples kept (memory bound: the interval is coarsened to fit).
     pub max_samples: usize,
@@ -42,7 +42,7 @@ pub struct SimOptions {
     pub skip_separated: bool,
     /// What a fixed step that cannot be accurate does: warn (default), raise, or nothing.
     pub step_check: StepCheck,
-    /// Smallest step of an adaptive method [s]; below it the run fails.
+    /// Smallest step of an adaptive method \[s\]; below it the run fails.
     pub h_min: f64,
     /// Most steps an adaptive method may take; beyond it the run fails.
     pub max_steps: u64,
@@ -94,7 +94,7 @@ impl SimOptions {
         }
     }
 
-    /// The step used by a fixed-step method [s] (the initial step of an adaptive one).
+    /// The step used by a fixed-step method \[s\] (the initial step of an adaptive one).
     pub fn default_dt(method: Method) -> f64 {
         method.default_dt()
     }
@@ -194,7 +194,7 @@ impl SimOptions {
         Ok(())
     }
 
-    /// The sample interval actually used [s].
+    /// The sample interval actually used \[s\].
     pub fn sample_interval(&self) -> f64 {
         let wanted = self.record_interval.unwrap_or(1e-4);
         wanted.max(self.t_end / (self.max_samples - 1) as f64)
@@ -213,7 +213,7 @@ impl RunControl {
     pub fn request_stop(&self) {
         self.stop.store(true, Ordering::Relaxed);
     }
-    /// Simulated time reached so far [s].
+    /// Simulated time reached so far \[s\].
     pub fn time(&self) -> f64 {
         f64::from_bits(self.time_bits.load(Ordering::Relaxed))
     }

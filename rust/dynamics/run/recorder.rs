@@ -416,7 +416,7 @@ pub struct Recording {
     pub stats: Stats,
     /// Why the run may be inaccurate (see `driver::fixed_step_warnings`).
     pub warnings: Vec<String>,
-    /// The state at the end of the run: time [s] and the model's free coordinates and
+    /// The state at the end of the run: time \[s\] and the model's free coordinates and
     /// velocities (`ReducerModel::initial_state` order), e.g. for a modal analysis about it.
     pub final_state: Option<(f64, Vec<f64>, Vec<f64>)>,
 }

@@ -23,7 +23,7 @@ pub trait ContactSink {
     fn wants_bearings(&self) -> bool {
         true
     }
-    /// Pin `j` on disc `k`: normal force [N], penetration [m], moment of the pin force about
+    /// Pin `j` on disc `k`: normal force \[N\], penetration \[m\], moment of the pin force about
     /// the disc centre [N m], contact point and unit outward profile normal (fixed frame).
     #[allow(clippy::too_many_arguments)]
     fn pin(
@@ -37,9 +37,9 @@ pub trait ContactSink {
         _normal: [f64; 2],
     ) {
     }
-    /// Mesh `i`: force along the line of action [N] (negative on the coast flank), deflection [m].
+    /// Mesh `i`: force along the line of action \[N\] (negative on the coast flank), deflection \[m\].
     fn mesh(&mut self, _i: usize, _force: f64, _deflection: f64) {}
-    /// Bearing force [N] (fixed frame): `family` 0 = crank bearing `index` (force on the crank
+    /// Bearing force \[N\] (fixed frame): `family` 0 = crank bearing `index` (force on the crank
     /// centre), 1 = eccentric bearing `index = crank * discs + disc` (force on the disc).
     fn bearing(&mut self, _family: usize, _index: usize, _force: [f64; 2]) {}
 }

@@ -28,15 +28,15 @@ use std::f64::consts::PI;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DiscSpec {
-    /// Phase of this disc's eccentric on the crank [rad] (0 and pi for the two-disc RV).
+    /// Phase of this disc's eccentric on the crank \[rad\] (0 and pi for the two-disc RV).
     pub phase: f64,
     /// Profile modifications of this disc [m, m, rad]; overrides the scene's `cycloid` values.
     #[serde(default)]
     pub d_rp: Option<f64>,
-    /// Equidistant modification of this disc [m] (`None` = the scene's).
+    /// Equidistant modification of this disc \[m\] (`None` = the scene's).
     #[serde(default)]
     pub d_rrp: Option<f64>,
-    /// Rotation modification of this disc [rad] (`None` = the scene's).
+    /// Rotation modification of this disc \[rad\] (`None` = the scene's).
     #[serde(default)]
     pub d_delta: Option<f64>,
     /// Profile error of this disc: a normal offset of the ground profile (`None` = none;
@@ -77,17 +77,17 @@ pub struct Shafts {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GearError {
-    /// Runout: eccentricity of the gear's toothing on its axis [m] (>= 0).
+    /// Runout: eccentricity of the gear's toothing on its axis \[m\] (>= 0).
     #[serde(default)]
     pub runout: f64,
-    /// Direction of the runout in the gear's body frame [rad].
+    /// Direction of the runout in the gear's body frame \[rad\].
     #[serde(default)]
     pub runout_phase: f64,
     /// Amplitude of a sinusoidal cumulative pitch deviation at the rotation order [m, on the
     /// reference circle]: `F(psi) = A sin(psi + pitch_phase)`, `psi` the body angle of the tooth.
     #[serde(default)]
     pub pitch_amplitude: f64,
-    /// Phase of the sinusoidal pitch deviation [rad].
+    /// Phase of the sinusoidal pitch deviation \[rad\].
     #[serde(default)]
     pub pitch_phase: f64,
     /// Cumulative pitch deviation of each tooth [m, on the reference circle] (empty, or one
@@ -104,7 +104,7 @@ impl GearError {
     }
 
     /// Check the fields (`at` names the gear, e.g. `"gear_errors.sun"`): finite, runout >= 0,
-    /// every deviation below `limit` [m] in magnitude, `teeth` deviations or none.
+    /// every deviation below `limit` \[m\] in magnitude, `teeth` deviations or none.
     pub fn check(&self, at: &str, teeth: u32, limit: f64) -> Result<()> {
         let bad = |m: String| Err(RvdynError::Scene(format!("{at}.{m}")));
         for (n, v) in [
@@ -174,10 +174,10 @@ impl GearErrors {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PinErrors {
-    /// Position error of each pin centre, (dx, dy) in the fixed frame [m].
+    /// Position error of each pin centre, (dx, dy) in the fixed frame \[m\].
     #[serde(default)]
     pub position: Vec<[f64; 2]>,
-    /// Radius error of each pin [m] (positive = larger pin).
+    /// Radius error of each pin \[m\] (positive = larger pin).
     #[serde(default)]
     pub radius: Vec<f64>,
 }
@@ -187,17 +187,17 @@ pub struct PinErrors {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AssemblyErrors {
-    /// Eccentricity error of each crank [m] (`e -> e + de_i`, both eccentrics of the crank).
+    /// Eccentricity error of each crank \[m\] (`e -> e + de_i`, both eccentrics of the crank).
     #[serde(default)]
     pub crank_eccentricity: Vec<f64>,
-    /// Phase error of each crank's eccentrics [rad].
+    /// Phase error of each crank's eccentrics \[rad\].
     #[serde(default)]
     pub crank_phase: Vec<f64>,
     /// Position error of each crank hole in each disc, `[crank][disc]` flattened as
-    /// `crank * discs + disc`, (dx, dy) in the disc frame [m].
+    /// `crank * discs + disc`, (dx, dy) in the disc frame \[m\].
     #[serde(default)]
     pub disc_holes: Vec<[f64; 2]>,
-    /// Position error of each crank seat in the carrier, (dx, dy) in the carrier frame [m].
+    /// Position error of each crank seat in the carrier, (dx, dy) in the carrier frame \[m\].
     #[serde(default)]
     pub carrier_seats: Vec<[f64; 2]>,
 }
@@ -212,7 +212,7 @@ impl AssemblyErrors {
     }
 
     /// Check lengths (`cranks`, `cranks * discs`), finiteness, and that an eccentricity error
-    /// stays below the eccentricity `e` [m] in magnitude.
+    /// stays below the eccentricity `e` \[m\] in magnitude.
     pub fn check(&self, cranks: usize, discs: usize, e: f64) -> Result<()> {
         let bad = |m: String| Err(RvdynError::Scene(m));
         for (n, len, want) in [
@@ -283,7 +283,7 @@ pub struct Bearing {
     pub stiffness: f64,
     /// Radial damping [N s/m] (with rollers: a parallel damper, 0 for none).
     pub damping: f64,
-    /// Radial clearance per side [m].
+    /// Radial clearance per side \[m\].
     #[serde(default)]
     pub clearance: f64,
     /// Roller (needle) bearing: nonlinear load-deflection from its rollers (Palmgren line
@@ -298,32 +298,32 @@ pub struct Bearing {
 pub struct Rollers {
     /// Number of rollers (at least 3).
     pub count: u32,
-    /// Effective roller length [m].
+    /// Effective roller length \[m\].
     pub length: f64,
-    /// Roller diameter [m] (for the ISO 281 load rating).
+    /// Roller diameter \[m\] (for the ISO 281 load rating).
     pub diameter: f64,
-    /// Pitch diameter of the roller set [m] (for the load rating).
+    /// Pitch diameter of the roller set \[m\] (for the load rating).
     pub pitch_diameter: f64,
     /// Damping ratio [-] of the stiffness-proportional roller damping, referred to
     /// `frequency`: each roller pushes with `max(0, Q + beta k delta')`,
     /// `beta = 2 damping_ratio / (2 pi frequency)`.
     pub damping_ratio: f64,
-    /// Reference frequency of the damping ratio [Hz].
+    /// Reference frequency of the damping ratio \[Hz\].
     pub frequency: f64,
 }
 
 impl Rollers {
-    /// The roller load-deflection law with the bearing's clearance [m].
+    /// The roller load-deflection law with the bearing's clearance \[m\].
     pub fn bearing(&self, clearance: f64) -> Result<crate::bearing::RollerBearing> {
         crate::bearing::RollerBearing::new(self.count as usize, self.length, clearance)
     }
 
-    /// `beta` [s] of the roller damping.
+    /// `beta` \[s\] of the roller damping.
     pub fn beta(&self) -> f64 {
         2.0 * self.damping_ratio / (std::f64::consts::TAU * self.frequency)
     }
 
-    /// ISO 281 basic dynamic load rating [N] (one row, `b_m = 1.1`).
+    /// ISO 281 basic dynamic load rating \[N\] (one row, `b_m = 1.1`).
     pub fn load_rating(&self) -> Result<f64> {
         crate::bearing::RollerBearingGeometry {
             rollers: self.count,
@@ -405,7 +405,7 @@ pub enum ContactLawSpec {
         exponent: f64,
         /// cmax [N s/m].
         max_damping: f64,
-        /// Penetration at which the full damping acts [m].
+        /// Penetration at which the full damping acts \[m\].
         damping_depth: f64,
     },
     /// Steel line contact from the face width (Palmgren, Harris: `delta = 3.84e-5 Q^0.9 /
@@ -413,13 +413,13 @@ pub enum ContactLawSpec {
     Palmgren {
         /// cmax [N s/m].
         max_damping: f64,
-        /// Penetration at which the full damping acts [m].
+        /// Penetration at which the full damping acts \[m\].
         damping_depth: f64,
     },
     /// Pins only: line contact of the pin and the local profile curvature (Johnson; see
     /// `contact::line_contact`), materials of pin and disc, and a damping law.
     Line {
-        /// Young's modulus of pins and discs [Pa] (default the paper's 2.17e11).
+        /// Young's modulus of pins and discs \[Pa\] (default the paper's 2.17e11).
         #[serde(default = "crate::contact::law::default_youngs_modulus")]
         youngs_modulus: f64,
         /// Poisson's ratio [-] (default 0.3).
@@ -457,7 +457,7 @@ impl ContactLawSpec {
         }
     }
 
-    /// The IMPACT-type law for a contact of length `face_width` [m] (`impact` and `palmgren`).
+    /// The IMPACT-type law for a contact of length `face_width` \[m\] (`impact` and `palmgren`).
     ///
     /// Errors (`Scene`) for `line` and `iso6336`, which are not IMPACT laws.
     pub fn law(&self, face_width: f64) -> Result<ImpactLaw> {
@@ -485,7 +485,7 @@ impl ContactLawSpec {
         }
     }
 
-    /// The pin/disc law for discs of face width `face_width` [m].
+    /// The pin/disc law for discs of face width `face_width` \[m\].
     ///
     /// Errors (`Scene`) for `iso6336` (a mesh law) and invalid parameters.
     pub fn pin_law(&self, face_width: f64) -> Result<PinLaw> {
@@ -662,7 +662,7 @@ pub enum Drive {
         speed: f64,
         /// How the speed starts.
         start: StartKind,
-        /// Ramp duration [s] (for `start = "ramp"`).
+        /// Ramp duration \[s\] (for `start = "ramp"`).
         #[serde(default)]
         ramp_time: f64,
     },
@@ -670,7 +670,7 @@ pub enum Drive {
     Torque {
         /// Input torque [N m].
         torque: f64,
-        /// Ramp duration [s] (0 = full torque from t = 0).
+        /// Ramp duration \[s\] (0 = full torque from t = 0).
         #[serde(default)]
         ramp_time: f64,
     },
@@ -687,18 +687,18 @@ pub enum Load {
         /// Torque [N m].
         torque: f64,
     },
-    /// `before` [N m] until `time` [s], then `after`.
+    /// `before` [N m] until `time` \[s\], then `after`.
     Step {
         /// Torque before the step [N m].
         before: f64,
         /// Torque after the step [N m].
         after: f64,
-        /// Time of the step [s].
+        /// Time of the step \[s\].
         time: f64,
     },
-    /// Piecewise-linear table of (t [s], torque [N m]), held constant outside.
+    /// Piecewise-linear table of (t \[s\], torque [N m]), held constant outside.
     Table {
-        /// (t [s], torque [N m]) pairs, times strictly increasing.
+        /// (t \[s\], torque [N m]) pairs, times strictly increasing.
         points: Vec<[f64; 2]>,
     },
 }

@@ -6,7 +6,7 @@ use crate::kinematics::operating_point;
 
 /// The paper's input speed, 8328 deg/s [rad/s].
 pub const PAPER_INPUT_SPEED: f64 = 8328.0 * PI / 180.0;
-/// The paper's power, 112 kW [W].
+/// The paper's power, 112 kW \[W\].
 pub const PAPER_POWER: f64 = 112e3;
 /// The paper's printed output torque [N m] (inconsistent with 112 kW: erratum 3).
 pub const PAPER_PRINTED_LOAD: f64 = 4024.9;
@@ -16,7 +16,7 @@ pub const PAPER_PRINTED_LOAD: f64 = 4024.9;
 /// meshes (docs/model.md, "Damping").
 pub const PHYSICAL_DAMPING_RATIO: f64 = 0.05;
 
-/// Reference frequency of the physical preset's damping [Hz]: its main torsional mode at rated
+/// Reference frequency of the physical preset's damping \[Hz\]: its main torsional mode at rated
 /// load (linearised model, docs/model.md), so that this mode has the damping ratio
 /// [`PHYSICAL_DAMPING_RATIO`].
 pub const PHYSICAL_REFERENCE_FREQUENCY: f64 = 1670.0;

@@ -85,11 +85,11 @@ pub fn default_joints() -> Joints {
 /// Energy flows of one force evaluation.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Flows {
-    /// Power dissipated by contact and bearing damping and by friction [W].
+    /// Power dissipated by contact and bearing damping and by friction \[W\].
     dissipation: f64,
-    /// Elastic energy of the contacts and bearings [J] (contacts only when asked for).
+    /// Elastic energy of the contacts and bearings \[J\] (contacts only when asked for).
     pub(crate) potential: f64,
-    /// Friction power per family [W]: pins, teeth, bearings (part of `dissipation`).
+    /// Friction power per family \[W\]: pins, teeth, bearings (part of `dissipation`).
     friction: [f64; 3],
 }
 
@@ -107,7 +107,7 @@ pub struct CompliantModel {
     pub(crate) cranks: usize,
     /// `(cos gamma_i, sin gamma_i)` of each crank seat.
     seats: Vec<[f64; 2]>,
-    /// Disc hole centres `h_ik` in the disc frame, at `i * discs + k` [m].
+    /// Disc hole centres `h_ik` in the disc frame, at `i * discs + k` \[m\].
     holes: Vec<[f64; 2]>,
     /// `(sin, cos)` of the pressure angle: `w_i = sin u_i + cos (z x u_i)`.
     pressure: [f64; 2],
@@ -130,9 +130,9 @@ pub struct CompliantModel {
     /// Skip the exact query of a pin that provably cannot touch ([`SeparationBound`]).
     pub(crate) skip_separated: bool,
     separation: Vec<Cell<SeparationBound>>,
-    /// Crank seats in the carrier frame, `r_cr (cos g_i, sin g_i)` plus the seat error [m].
+    /// Crank seats in the carrier frame, `r_cr (cos g_i, sin g_i)` plus the seat error \[m\].
     seat_vecs: Vec<[f64; 2]>,
-    /// Eccentricity [m] and phase error [rad] of each crank.
+    /// Eccentricity \[m\] and phase error \[rad\] of each crank.
     ecc_radius: Vec<f64>,
     ecc_phase: Vec<f64>,
     /// Palmgren friction of the eccentric and crank bearings, with the regularisation speeds
@@ -425,7 +425,7 @@ impl CompliantModel {
     }
 
     /// Deflection `d = p_i - s_i` of crank bearing `i` and `d = H_ik - E_ik` of eccentric
-    /// bearing `(i, k)` (at `i * discs + k`) for the full coordinates `x` [m].
+    /// bearing `(i, k)` (at `i * discs + k`) for the full coordinates `x` \[m\].
     pub fn bearing_deflections(&self, x: &[f64]) -> (Vec<[f64; 2]>, Vec<[f64; 2]>) {
         let m = &self.parts;
         let nd = m.discs.len();
@@ -477,7 +477,7 @@ impl CompliantModel {
         (sh, li, mi)
     }
 
-    /// Kinetic energy of the free bodies [J] (a prescribed input is a driver, not counted).
+    /// Kinetic energy of the free bodies \[J\] (a prescribed input is a driver, not counted).
     fn kinetic_energy(&self, v: &[f64]) -> f64 {
         self.coords
             .iter()
