@@ -446,6 +446,8 @@ impl CycloidGeometry {
             && dist >= 0.0
             && dist < k.ambiguity_distance
         {
+            // The first iteration evaluates the same point again (the compiler shares the
+            // two: keeping it in an Option instead cost 1.3 % more instructions).
             let d = Derivs::new(k, u, v);
             let inv_len = 1.0 / dot(d.d1, d.d1).sqrt();
             let n = [d.d1[1] * inv_len, -d.d1[0] * inv_len];

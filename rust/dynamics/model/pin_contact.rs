@@ -188,11 +188,12 @@ pub(crate) enum PinQuery {
 /// The exact pin query (as `pin_query`), or [`PinQuery::Open`] with a lower bound of the gap
 /// when `open_test` is set and the pin is shown open at the seed, from its last exact gap
 /// carried along the disc's rotation
-/// ([`crate::geometry::CycloidGeometry::contact_foot_or_open`]: the seed is the last foot turned with the disc,
-/// and the pin keeps its place relative to a conjugate profile, so the test stays tight while
-/// the disc moves farther than the gap, where [`SeparationBound`] cannot skip). The warm start
-/// then moves to the seed and keeps its gap (a lower bound is all the test needs). Rigid
-/// profiles only: the caller sets `open_test` only without profile errors.
+/// ([`crate::geometry::CycloidGeometry::contact_foot_or_open`]: the seed is the last foot
+/// turned with the disc, and the pin keeps its place relative to a conjugate profile, so the
+/// test stays tight while the disc moves farther than the gap, where [`SeparationBound`]
+/// cannot skip). The warm start then moves to the seed and keeps its gap (a lower bound is all
+/// the test needs). Rigid profiles only: the caller sets `open_test` only without profile
+/// errors.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn pin_query_or_open(
