@@ -15,7 +15,8 @@
 //! transmission errors at 360 crank angles: four sweeps of equilibria without reports, loaded and
 //! unloaded in both directions) or `loop` (N 200-point torque-twist loops at crank angle 0).
 //! Prints the Newton iterations and force evaluations used, and with `LTCA_WORK_RESULTS` set
-//! the results (for A/B comparisons of the same workload).
+//! the results (for A/B comparisons of the same workload). `LTCA_WORK_LIGHT` sets the light
+//! load of `bare` as a fraction of the torque (default 1e-6).
 use rvdyn::analysis::ltca::Ltca;
 use rvdyn::dynamics::compliant::default_joints;
 use rvdyn::dynamics::scene::{ContactLawSpec, Scene};
@@ -81,7 +82,11 @@ fn ltca_work(
         }
         "bare" => {
             for _ in 0..n {
-                let te = ltca.transmission_error(black_box(torque), 1e-6 * torque, 360, 0.0)?;
+                let lf: f64 = std::env::var("LTCA_WORK_LIGHT")
+                    .ok()
+                    .and_then(|v| v.parse().ok())
+                    .unwrap_or(1e-6);
+                let te = ltca.transmission_error(black_box(torque), lf * torque, 360, 0.0)?;
                 if std::env::var_os("LTCA_WORK_RESULTS").is_some() {
                     let pp = rvdyn::analysis::ltca::peak_to_peak;
                     println!(

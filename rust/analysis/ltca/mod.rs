@@ -369,35 +369,51 @@ impl Ltca {
         // crank angle), extrapolated by the polynomial through them in the crank angle (or the
         // torque).
         let mut q = predictor(&self.history, psi, torque, kin);
-        let rep = match equilibrium(
-            st,
-            psi,
-            torque,
-            &mut q,
-            self.k_ref,
-            &self.options,
-            &mut self.work,
-            &mut self.scratch,
-            self.capture,
-        ) {
-            Ok(r) => r,
+        let mut solve = |q: &mut [f64], options: &NewtonOptions| {
+            equilibrium(
+                st,
+                psi,
+                torque,
+                q,
+                self.k_ref,
+                options,
+                &mut self.work,
+                &mut self.scratch,
+                self.capture,
+            )
+        };
+        let first = match solve(&mut q, &self.options) {
+            Ok(r) => Ok(r),
             Err(e) if !self.history.is_empty() => {
                 // A warm start from far away can be worse than the kinematic pose.
                 let _ = e;
-                let mut q2 = st.kinematic_unknowns(psi);
-                let r = equilibrium(
-                    st,
-                    psi,
-                    torque,
-                    &mut q2,
-                    self.k_ref,
-                    &self.options,
-                    &mut self.work,
-                    &mut self.scratch,
-                    self.capture,
-                )?;
-                q = q2;
+                let mut q2 = kin_here.clone();
+                let r = solve(&mut q2, &self.options);
+                if r.is_ok() {
+                    q = q2;
+                }
                 r
+            }
+            Err(e) => Err(e),
+        };
+        let rep = match first {
+            Ok(r) => r,
+            Err(e) if !self.options.regularise_singular => {
+                // Last, from the kinematic pose with the singular directions alone
+                // regularised (a light load with bodies floating in their clearances, where
+                // damping every direction stalls: BENCHMARKS.md section 10.4).
+                let regularised = NewtonOptions {
+                    regularise_singular: true,
+                    ..self.options
+                };
+                let mut q3 = kin_here.clone();
+                match solve(&mut q3, &regularised) {
+                    Ok(r) => {
+                        q = q3;
+                        r
+                    }
+                    Err(_) => return Err(e),
+                }
             }
             Err(e) => return Err(e),
         };

@@ -95,7 +95,30 @@ fn cholesky_solve(m: &[f64], n: usize, b: &mut [f64], tiny: f64) -> Option<bool>
         }
         let (l, rest) = scratch.split_at_mut(n * n);
         let (inv_diag, y) = rest.split_at_mut(n);
-        cholesky_in(m, n, b, tiny, l, inv_diag, &mut y[..n])
+        cholesky_in(m, n, b, tiny, None, l, inv_diag, &mut y[..n])
+    })
+}
+
+/// Solve `m x = b` for a symmetric `m` by a modified Cholesky factorization (Gill, Murray and
+/// Wright, Practical Optimization, 1981, section 4.4.2.2): a pivot `d_j` not above `tiny` is
+/// replaced by `max(|d_j|, floor[j])`, which adds to `m` a diagonal perturbation only in the
+/// directions that are singular (or indefinite) to working accuracy, so the step stays the
+/// Newton step in every other direction and is a descent direction. False for an
+/// unsymmetric or non-finite `m` (or a non-finite result).
+fn modified_cholesky_solve(m: &[f64], n: usize, b: &mut [f64], floor: &[f64]) -> bool {
+    let m = &m[..n * n];
+    let b = &mut b[..n];
+    let amax = m.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    if amax == 0.0 || !amax.is_finite() || !symmetric(m, n, 1e-13 * amax) {
+        return false;
+    }
+    CHOLESKY_SCRATCH.with_borrow_mut(|scratch| {
+        if scratch.len() < n * n + 2 * n {
+            scratch.resize(n * n + 2 * n, 0.0);
+        }
+        let (l, rest) = scratch.split_at_mut(n * n);
+        let (inv_diag, y) = rest.split_at_mut(n);
+        cholesky_in(m, n, b, 1e-14 * amax, Some(floor), l, inv_diag, &mut y[..n]).unwrap_or(false)
     })
 }
 
@@ -135,12 +158,15 @@ fn cholesky_fixed<const N: usize>(m: &[f64], b: &mut [f64], tiny: f64) -> Option
     Some(b.iter().all(|v| v.is_finite()))
 }
 
-/// [`cholesky_solve`] with its scratch: `l` (`n * n`), `inv_diag` and `y` (`n` each).
+/// [`cholesky_solve`] with its scratch: `l` (`n * n`), `inv_diag` and `y` (`n` each); with
+/// `floor`, the modified factorization of [`modified_cholesky_solve`].
+#[allow(clippy::too_many_arguments)]
 fn cholesky_in(
     m: &[f64],
     n: usize,
     b: &mut [f64],
     tiny: f64,
+    floor: Option<&[f64]>,
     l: &mut [f64],
     inv_diag: &mut [f64],
     y: &mut [f64],
@@ -153,9 +179,12 @@ fn cholesky_in(
             let s = dot_from(aj[k], &lj[..k], &done[k * n..k * n + k]);
             lj[k] = s * inv_diag[k];
         }
-        let d = dot_from(aj[j], &lj[..j], &lj[..j]);
-        if d.is_nan() || d <= tiny {
+        let mut d = dot_from(aj[j], &lj[..j], &lj[..j]);
+        if d.is_nan() {
             return None;
+        }
+        if d <= tiny {
+            d = d.abs().max(floor?[j]);
         }
         let r = d.sqrt();
         lj[j] = r;
@@ -259,6 +288,12 @@ pub struct NewtonOptions {
     pub tolerance: f64,
     /// Most iterations per equilibrium.
     pub max_iterations: usize,
+    /// Where the tangent is singular to working accuracy, try the Newton step with only the
+    /// singular directions regularised (a modified Cholesky factorization) before damping
+    /// every direction (Levenberg-Marquardt). Off by default: [`crate::analysis::ltca::Ltca`]
+    /// turns it on for a second attempt at an equilibrium the default iteration failed to find
+    /// (measured: BENCHMARKS.md section 10.4).
+    pub regularise_singular: bool,
 }
 
 impl Default for NewtonOptions {
@@ -266,6 +301,7 @@ impl Default for NewtonOptions {
         Self {
             tolerance: 1e-12,
             max_iterations: 200,
+            regularise_singular: false,
         }
     }
 }
@@ -303,6 +339,7 @@ pub struct Scratch {
     dq: Vec<f64>,
     qt: Vec<f64>,
     scale: Vec<f64>,
+    floor: Vec<f64>,
     /// Contact state of the evaluation at the solution (filled when `capture` is asked for).
     pub state: ContactState,
     trial: ContactState,
@@ -311,7 +348,13 @@ pub struct Scratch {
 impl Scratch {
     fn size(&mut self, n: usize) {
         if self.k.n != n || self.r.len() != n {
-            for v in [&mut self.r, &mut self.rt, &mut self.dq, &mut self.qt] {
+            for v in [
+                &mut self.r,
+                &mut self.rt,
+                &mut self.dq,
+                &mut self.qt,
+                &mut self.floor,
+            ] {
                 *v = vec![0.0; n];
             }
             for m in [&mut self.k, &mut self.kt, &mut self.a] {
@@ -364,6 +407,7 @@ pub fn equilibrium(
         state,
         trial: trial_state,
         scale,
+        floor,
     } = scratch;
     let scale: &[f64] = scale;
     // Whether the last evaluation (whose full forces `work` keeps) is at `q`.
@@ -398,8 +442,21 @@ pub fn equilibrium(
             }
             dq.copy_from_slice(r);
             if !solve_dense(a, dq) {
-                mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
-                continue;
+                // Singular to working accuracy (a body floating in a clearance, a contact at
+                // first touch). With `regularise_singular`, first the Newton step with the
+                // singular directions alone regularised (as the damping below, 1e-6 k_ref per
+                // unit length squared); otherwise, and if that fails, damping of all.
+                dq.copy_from_slice(r);
+                for (f, l) in floor.iter_mut().zip(scale) {
+                    *f = 1e-6 * k_ref * l * l;
+                }
+                if !opts.regularise_singular
+                    || mu > 0.0
+                    || !modified_cholesky_solve(&k.a, n, dq, floor)
+                {
+                    mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
+                    continue;
+                }
             }
             // Line search along dq. The fast path is the full step when it reduces the
             // residual. Otherwise a one-dimensional search for the minimum of the potential
@@ -617,7 +674,7 @@ mod tests {
             let (mut l, mut inv, mut y) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
             let mut general = b.clone();
             assert_eq!(
-                cholesky_in(&m, n, &mut general, 1e-14, &mut l, &mut inv, &mut y),
+                cholesky_in(&m, n, &mut general, 1e-14, None, &mut l, &mut inv, &mut y),
                 Some(true)
             );
             assert_eq!(via_dispatch, general, "size {n}");
@@ -696,5 +753,37 @@ mod tests {
             a: vec![1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 2.0],
         };
         assert!(!solve_dense(&mut s, &mut [1.0, 1.0, 1.0]));
+    }
+
+    /// The modified factorization changes only the singular (or indefinite) directions: on a
+    /// block-diagonal matrix with a regular block, a zero row and a negative pivot, the step
+    /// is the exact solve on the regular block, `b / floor` on the zero row and `b / |d|` on
+    /// the negative one (a descent direction); an unsymmetric matrix is refused.
+    #[test]
+    fn modified_cholesky_regularises_only_the_singular_directions() {
+        // [[4, 1, 0, 0], [1, 3, 0, 0], [0, 0, 0, 0], [0, 0, 0, -2]]
+        let mut m = vec![0.0; 16];
+        m[0] = 4.0;
+        m[1] = 1.0;
+        m[4] = 1.0;
+        m[5] = 3.0;
+        m[15] = -2.0;
+        let floor = [1e-3, 1e-3, 0.5, 1e-3];
+        let mut b = [1.0, 2.0, 3.0, 4.0];
+        assert!(modified_cholesky_solve(&m, 4, &mut b, &floor));
+        // The regular block: 4 x + y = 1, x + 3 y = 2.
+        let (x, y) = (1.0 / 11.0, 7.0 / 11.0);
+        assert!(
+            (b[0] - x).abs() < 1e-15 && (b[1] - y).abs() < 1e-15,
+            "{b:?}"
+        );
+        assert!((b[2] - 3.0 / 0.5).abs() < 1e-14, "{b:?}");
+        assert!((b[3] - 4.0 / 2.0).abs() < 1e-14, "{b:?}");
+        // The plain factorization refuses the same matrix.
+        let mut plain = Dense { n: 4, a: m.clone() };
+        assert!(!solve_dense(&mut plain, &mut [1.0, 2.0, 3.0, 4.0]));
+        // Unsymmetric: refused.
+        m[2] = 0.5;
+        assert!(!modified_cholesky_solve(&m, 4, &mut [1.0; 4], &floor));
     }
 }
