@@ -410,6 +410,12 @@ pub fn equilibrium(
         floor,
     } = scratch;
     let scale: &[f64] = scale;
+    if opts.regularise_singular {
+        // The modified factorization's floor: the first damping below, per direction.
+        for (f, l) in floor.iter_mut().zip(scale) {
+            *f = 1e-6 * k_ref * l * l;
+        }
+    }
     // Whether the last evaluation (whose full forces `work` keeps) is at `q`.
     let mut last_at_q = true;
     // Before returning: with `capture`, the last evaluation must be at `q`.
@@ -446,14 +452,11 @@ pub fn equilibrium(
                 // first touch). With `regularise_singular`, first the Newton step with the
                 // singular directions alone regularised (as the damping below, 1e-6 k_ref per
                 // unit length squared); otherwise, and if that fails, damping of all.
-                dq.copy_from_slice(r);
-                for (f, l) in floor.iter_mut().zip(scale) {
-                    *f = 1e-6 * k_ref * l * l;
-                }
-                if !opts.regularise_singular
-                    || mu > 0.0
-                    || !modified_cholesky_solve(&k.a, n, dq, floor)
-                {
+                let regularised = opts.regularise_singular && mu == 0.0 && {
+                    dq.copy_from_slice(r);
+                    modified_cholesky_solve(&k.a, n, dq, floor)
+                };
+                if !regularised {
                     mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
                     continue;
                 }
