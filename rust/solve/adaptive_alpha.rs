@@ -39,7 +39,10 @@
 //! accepted when its error per step (the norm without the factor `VELOCITY_ERROR_TIME / h`) is
 //! within the tolerance: error-per-step control, which a low-order event can satisfy (Hairer,
 //! Norsett & Wanner, Solving ODEs I, 2nd ed., section II.4, on error per step and per unit
-//! step). Counted as `nonsmooth` in the statistics.
+//! step). Counted as `nonsmooth` in the statistics. As a last resort, a rejected step whose
+//! retry would fall below `h_min` is accepted the same way when its error per step allows (a
+//! force that switches on and off step after step, where each new row of rejections would
+//! shrink the step again).
 //!
 //! **First touch.** A step that closes a contact from open to deeper than its law's damping
 //! ramp (`MechanicalSystem::deepest_first_touch`, the IMPACT law's damping depth) is rejected and
@@ -182,6 +185,21 @@ impl AdaptiveAlpha {
     }
 }
 
+impl AdaptiveAlpha {
+    /// Take the step `a` of size `h` on its error per step (counted as `nonsmooth`); the next
+    /// step is as long.
+    fn accept_nonsmooth(&mut self, sys: &dyn MechanicalSystem, st: &mut State, a: Attempt, h: f64) {
+        self.streak = 0;
+        self.streak_end = f64::NEG_INFINITY;
+        self.accepted += 1;
+        self.nonsmooth += 1;
+        self.err_prev = 1.0;
+        self.stepper.accept(st, a);
+        sys.mark_open_contacts();
+        self.h = h.clamp(self.h_min, self.h_max);
+    }
+}
+
 impl Integrator for AdaptiveAlpha {
     fn advance(&mut self, sys: &dyn MechanicalSystem, st: &mut State, t_end: f64) -> Result<()> {
         if self.accepted >= self.max_steps {
@@ -253,14 +271,18 @@ impl Integrator for AdaptiveAlpha {
                     // the run passes the end of the last rejected step.
                     let per_step = err * h / VELOCITY_ERROR_TIME;
                     if self.streak >= MAX_REJECTIONS && per_step <= 1.0 {
-                        self.streak = 0;
-                        self.streak_end = f64::NEG_INFINITY;
-                        self.accepted += 1;
-                        self.nonsmooth += 1;
-                        self.err_prev = 1.0;
-                        self.stepper.accept(st, a);
-                        sys.mark_open_contacts();
-                        self.h = h.clamp(self.h_min, self.h_max);
+                        self.accept_nonsmooth(sys, st, a, h);
+                        return Ok(());
+                    }
+                    // A force that switches back and forth within microseconds (a roller's
+                    // damper held at zero by "never pull", on the edge of separating) can
+                    // need such steps one after another: each new row of rejections would
+                    // shrink the step again, below h_min. Rather than stop the run there, a
+                    // step whose error per step is within the tolerance is taken (a last
+                    // resort: runs that never reach h_min are not changed by it).
+                    let retry = (0.9 * err.powf(-0.5)).clamp(0.2, 0.9);
+                    if h * retry < self.h_min && per_step <= 1.0 {
+                        self.accept_nonsmooth(sys, st, a, h);
                         return Ok(());
                     }
                     self.rejected += 1;
@@ -269,7 +291,7 @@ impl Integrator for AdaptiveAlpha {
                     if err > 10.0 {
                         self.stepper.restart();
                     }
-                    ((0.9 * err.powf(-0.5)).clamp(0.2, 0.9), "error test")
+                    (retry, "error test")
                 }
                 Ok(_) => {
                     self.retried += 1;
