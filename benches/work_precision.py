@@ -39,6 +39,18 @@ work_precision_tolerance.png (error against the tolerance or step); a recommenda
 cheapest setting of each integrator with a max pin-force error <= 0.1 % of the peak) is printed
 and stored.
 
+``--preset physical`` measures ``Scene.physical("rated")`` instead (line-contact pin law, ISO
+mesh stiffness, compliant roller bearings with clearance, damping ratio 0.05; drive ramped from
+rest over 0.05 s), with the same span, window, samples and error measures, and writes
+work_precision_physical.{png,json,md} and work_precision_physical_tolerance.png. Its modes reach
+8 kHz and its roller contacts are stiff, so the settings are scaled to it: generalized-alpha dt
+in {5e-6, 1e-5, 2e-5, 5e-5, 1e-4} s; generalized-alpha-adaptive atol in {1e-7, 3e-8, 1e-8,
+3e-9} m with rtol = 1e4 atol (the ratio of benches/speed_goal.py's physical settings); rk4 dt in
+{2.5e-6, 5e-6, 1e-5, 2e-5, 4e-5} s; dopri5 (atol, rtol) in {(1e-7, 1e-3), (1e-8, 3e-4),
+(1e-8, 1e-4), (1e-9, 1e-5), (1e-10, 1e-6)}. Reference dopri5 atol 1e-12 m, rtol 1e-8, checked
+against dopri5 atol 1e-13 m, rtol 1e-9 and rk4 at dt 1e-6 s (the tightest settings
+benches/speed_goal.py showed to agree to 2.4e-6 of the peak over 5 s). About 3 minutes.
+
 Run: ``python benches/work_precision.py`` from the repository root, with the extension built
 (``maturin develop --release``). Takes about 70 s on a lightly loaded 2-core machine (the
 budget is 10 minutes).
@@ -84,6 +96,19 @@ SETTINGS = (
     + [("dopri5", {"atol": atol}) for atol in (1e-7, 1e-8, 1e-9, 1e-10)]
     + [("dopri5", {"atol": 1e-11, "rtol": 1e-9}), ("dopri5", {"atol": 1e-12, "rtol": 1e-10})]
 )
+
+# The physical preset (see the module docstring).
+PHYSICAL_REFERENCE = ("dopri5", {"atol": 1e-12, "rtol": 1e-8})
+PHYSICAL_CHECKS = [("dopri5", {"atol": 1e-13, "rtol": 1e-9}), ("rk4", {"dt": 1e-6})]
+PHYSICAL_SETTINGS = (
+    [("generalized-alpha", {"dt": dt}) for dt in (5e-6, 1e-5, 2e-5, 5e-5, 1e-4)]
+    + [("generalized-alpha-adaptive", {"atol": atol, "rtol": 1e4 * atol}) for atol in (1e-7, 3e-8, 1e-8, 3e-9)]
+    + [("rk4", {"dt": dt}) for dt in (2.5e-6, 5e-6, 1e-5, 2e-5, 4e-5)]
+    + [("dopri5", {"atol": a, "rtol": r}) for a, r in ((1e-7, 1e-3), (1e-8, 3e-4), (1e-8, 1e-4), (1e-9, 1e-5),
+                                                       (1e-10, 1e-6))]
+)
+# Line style and marker fill of each block in the plots.
+STYLES = {"rigid": ("-", True), "compliant": ("--", False), "physical": ("-", True)}
 
 RESULTS = Path(__file__).resolve().parent / "results"
 
@@ -142,30 +167,31 @@ def log(msg: str) -> None:
     print(msg, flush=True)
 
 
-def measure(name: str, scene: Scene, theory: float) -> dict:
-    log(f"\n== {name} joints ==")
+def measure(name: str, scene: Scene, theory: float, reference=REFERENCE, checks=CONVERGENCE_CHECKS,
+            settings=SETTINGS) -> dict:
+    log(f"\n== {name} ==")
     t0 = time.perf_counter()
-    ref_result, core, py = run(scene, *REFERENCE, repeat=False)
+    ref_result, core, py = run(scene, *reference, repeat=False)
     ref = Reference(ref_result, theory)
-    log(f"reference {REFERENCE[0]} {label(*REFERENCE)}: {py:.2f} s, {int(ref_result.stats['steps'])} steps; "
+    log(f"reference {reference[0]} {label(*reference)}: {py:.2f} s, {int(ref_result.stats['steps'])} steps; "
         f"peak pin force in the window {ref.peak:.1f} N (whole run {ref_result.pin_force.max():.1f} N); "
         f"mean output speed / theory - 1 = {ref.speed / theory - 1:.3e}")
     out = {
-        "reference": {"integrator": REFERENCE[0], **REFERENCE[1], "wall_time": core, "python_time": py,
+        "reference": {"integrator": reference[0], **reference[1], "wall_time": core, "python_time": py,
                       "steps": ref_result.stats["steps"], "peak_pin_force_window": ref.peak,
                       "peak_pin_force_run": float(ref_result.pin_force.max()),
                       "mean_output_speed": ref.speed, "speed_vs_theory": ref.speed / theory - 1.0},
         "convergence": [],
         "runs": [],
     }
-    for integ, opts in CONVERGENCE_CHECKS:
+    for integ, opts in checks:
         r, core, py = run(scene, integ, opts, repeat=False)
         e = ref.errors(r)
         out["convergence"].append({"integrator": integ, **opts, "wall_time": core, **e})
         log(f"convergence check {integ} {label(integ, opts)} vs reference: pin max {e['pin_max_rel']:.2e}, "
             f"rms {e['pin_rms_rel']:.2e} (of the peak), speed {e['speed_rel']:.1e}, disc {e['disc_max_m']:.1e} m "
             f"[{py:.1f} s]")
-    for integ, opts in SETTINGS:
+    for integ, opts in settings:
         row = {"integrator": integ, "setting": label(integ, opts), **opts}
         try:
             r, core, py = run(scene, integ, opts)
@@ -218,8 +244,8 @@ def plot(data: dict, path: Path) -> None:
 
     fig, axes = plt.subplots(2, 2, figsize=(12, 9.5))
     for ax, (key, title) in zip(axes.flat, MEASURES):
-        for joints, style, fill in (("rigid", "-", True), ("compliant", "--", False)):
-            block = data["joints"][joints]
+        for joints, block in data["joints"].items():
+            style, fill = STYLES[joints]
             for integ, color in COLORS.items():
                 # In the order of the settings (step or tolerance), so a curve that turns back
                 # (no gain from a smaller step) shows as such.
@@ -228,14 +254,14 @@ def plot(data: dict, path: Path) -> None:
                 if pts:
                     x, y = zip(*pts)
                     ax.plot(x, y, style, color=color, marker="o", mfc=color if fill else "white",
-                            label=f"{integ}, {joints} joints")
+                            label=f"{integ}, {block_name(joints)}")
             bad = [(max(r[key], FLOOR), r["wall_time"]) for r in block["runs"] if r["status"].startswith("wrong")]
             if bad:
                 ax.plot(*zip(*bad), "x", color="red", ms=9, ls="none",
-                        label=f"wrong without an error, {joints} joints")
+                        label=f"wrong without an error, {block_name(joints)}")
             # Reference uncertainty: the largest disagreement of the convergence checks.
             floor = max(max(c[key] for c in block["convergence"]), FLOOR)
-            ax.axvline(floor, color="grey", ls=style, lw=0.8, label=f"reference uncertainty, {joints} joints")
+            ax.axvline(floor, color="grey", ls=style, lw=0.8, label=f"reference uncertainty, {block_name(joints)}")
         if key == "pin_max_rel":
             ax.axvline(PIN_TOLERANCE, color="red", lw=0.8, ls=":", label="0.1 % of the peak pin force")
         ax.set(xscale="log", yscale="log", xlabel="error", ylabel="core wall time [s]", title=title)
@@ -245,10 +271,12 @@ def plot(data: dict, path: Path) -> None:
         for h, lab in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(lab, h)
     fig.legend(list(handles.values()), list(handles), loc="lower center", ncol=3, fontsize="small")
-    fig.suptitle(f"rvdyn work-precision: Scene.paper('rated'), {T_END} s from rest, errors over "
-                 f"[{WINDOW_START}, {T_END}] s against dopri5 atol {REFERENCE[1]['atol']:g}, rtol {REFERENCE[1]['rtol']:g}\n"
-                 "solid/filled: rigid joints; dashed/open: compliant joints; curves in the order of the step "
-                 "or tolerance; errors at the grey lines are upper bounds", fontsize=9)
+    ref = data["reference"]
+    blocks = "; ".join(f"{'solid/filled' if STYLES[j][1] else 'dashed/open'}: {block_name(j)}" for j in data["joints"])
+    fig.suptitle(f"rvdyn work-precision: {data['scene']}, {T_END} s from rest, errors over "
+                 f"[{WINDOW_START}, {T_END}] s against dopri5 atol {ref['atol']:g}, rtol {ref['rtol']:g}\n"
+                 f"{blocks}; curves in the order of the step or tolerance; errors at the grey lines are upper "
+                 "bounds", fontsize=9)
     fig.tight_layout(rect=(0, 0.1, 1, 1))
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -262,7 +290,8 @@ def plot_tolerance(data: dict, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, (left, right) = plt.subplots(1, 2, figsize=(12, 5))
-    for joints, style, fill in (("rigid", "-", True), ("compliant", "--", False)):
+    for joints in data["joints"]:
+        style, fill = STYLES[joints]
         for integ, color in COLORS.items():
             rows = [r for r in data["joints"][joints]["runs"] if r["integrator"] == integ and r["status"] == "ok"]
             ax, key = (right, "dt") if rows and "dt" in rows[0] else (left, "atol")
@@ -270,26 +299,32 @@ def plot_tolerance(data: dict, path: Path) -> None:
             if pts:
                 x, y = zip(*pts)
                 ax.plot(x, y, style, color=color, marker="o", mfc=color if fill else "white",
-                        label=f"{integ}, {joints} joints")
+                        label=f"{integ}, {block_name(joints)}")
     for ax, xlabel in ((left, "atol [m] (rtol as in the settings)"), (right, "dt [s]")):
         ax.axhline(PIN_TOLERANCE, color="red", lw=0.8, ls=":", label="0.1 % of the peak pin force")
         ax.set(xscale="log", yscale="log", xlabel=xlabel, ylabel="pin force, max |error| / peak")
         ax.grid(True, which="major", alpha=0.3)
         ax.legend(fontsize="small")
-    left.set_title("adaptive methods: error against tolerance")
-    right.set_title("fixed-step methods: error against step")
+    left.set_title(f"{data['scene']}, adaptive methods: error against tolerance", fontsize=10)
+    right.set_title(f"{data['scene']}, fixed-step methods: error against step", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
+def block_name(joints: str) -> str:
+    """The legend's name of a block of runs: the joints of the paper scene, or the preset."""
+    return "physical preset" if joints == "physical" else f"{joints} joints"
+
+
 def markdown(data: dict) -> str:
+    ref = data["reference"]
     lines = [
         "# Work-precision (benches/work_precision.py)",
         "",
-        f"Scene `Scene.paper(\"rated\")`, {T_END} s from rest (step start), samples every {RECORD_INTERVAL:g} s, "
-        f"errors over [{WINDOW_START}, {T_END}] s against dopri5 atol {REFERENCE[1]['atol']:g} m, "
-        f"rtol {REFERENCE[1]['rtol']:g}. Pin-force errors relative to the reference's peak pin force in the "
+        f"Scene `{data['scene']}`, {T_END} s from rest, samples every {RECORD_INTERVAL:g} s, "
+        f"errors over [{WINDOW_START}, {T_END}] s against dopri5 atol {ref['atol']:g} m, "
+        f"rtol {ref['rtol']:g}. Pin-force errors relative to the reference's peak pin force in the "
         "window. Times: Rust core (`stats['wall_time']`) and the Python call, best of 2 for runs under 1 s.",
         f"Machine: {data['machine']['cpus']} cores, load average at start {data['machine']['load_average']}.",
         "",
@@ -297,10 +332,10 @@ def markdown(data: dict) -> str:
     for joints, block in data["joints"].items():
         ref = block["reference"]
         lines += [
-            f"## {joints} joints",
+            f"## {block_name(joints)}",
             "",
             f"Reference: {ref['wall_time']:.2f} s, peak pin force {ref['peak_pin_force_window']:.1f} N in the "
-            f"window ({ref['peak_pin_force_run']:.1f} N over the whole run); mean output speed / (input/57) - 1 = "
+            f"window ({ref['peak_pin_force_run']:.1f} N over the whole run); mean output speed / (input / ratio) - 1 = "
             f"{ref['speed_vs_theory']:.2e}.",
             "",
             "Convergence of the reference (the other run against it):",
@@ -337,41 +372,54 @@ def markdown(data: dict) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--joints", choices=["rigid", "compliant", "both"], default="both")
+    parser.add_argument("--preset", choices=["paper", "physical"], default="paper")
+    parser.add_argument("--joints", choices=["rigid", "compliant", "both"], default="both",
+                        help="paper preset only")
     args = parser.parse_args()
     RESULTS.mkdir(exist_ok=True)
     start = time.perf_counter()
-    all_scenes = scenes()
-    theory = all_scenes["rigid"]["drive.speed"] / all_scenes["rigid"].model_info()["ratio"]
+    if args.preset == "paper":
+        all_scenes = scenes()
+        names = ["rigid", "compliant"] if args.joints == "both" else [args.joints]
+        reference, checks, settings, stem = REFERENCE, CONVERGENCE_CHECKS, SETTINGS, "work_precision"
+        scene_name = 'Scene.paper("rated")'
+    else:
+        all_scenes = {"physical": Scene.physical("rated")}
+        names = ["physical"]
+        reference, checks, settings = PHYSICAL_REFERENCE, PHYSICAL_CHECKS, PHYSICAL_SETTINGS
+        stem, scene_name = "work_precision_physical", 'Scene.physical("rated")'
+    first = all_scenes[names[0]]
+    theory = first["drive.speed"] / first.model_info()["ratio"]
     data = {
-        "scene": 'Scene.paper("rated")',
+        "scene": scene_name,
         "t_end": T_END, "window": [WINDOW_START, T_END], "record_interval": RECORD_INTERVAL,
-        "channels": CHANNELS, "reference": {"integrator": REFERENCE[0], **REFERENCE[1]},
-        "compliant_joints": COMPLIANT_JOINTS, "theory_output_speed": theory,
+        "channels": CHANNELS, "reference": {"integrator": reference[0], **reference[1]},
+        "theory_output_speed": theory,
         "machine": {"cpus": os.cpu_count(), "load_average": [round(x, 2) for x in os.getloadavg()],
                     "python": platform.python_version(), "rvdyn": rvdyn.__version__},
         "joints": {},
     }
-    names = ["rigid", "compliant"] if args.joints == "both" else [args.joints]
+    if args.preset == "paper":
+        data["compliant_joints"] = COMPLIANT_JOINTS
     for name in names:
         try:
-            data["joints"][name] = measure(name, all_scenes[name], theory)
+            data["joints"][name] = measure(name, all_scenes[name], theory, reference, checks, settings)
         except rvdyn.RvdynError as exc:  # e.g. the compliant model not available in this build
-            log(f"{name} joints could not be run: {type(exc).__name__}: {exc}")
+            log(f"{block_name(name)} could not be run: {type(exc).__name__}: {exc}")
             data["joints"][name] = {"error": f"{type(exc).__name__}: {exc}"}
     data["elapsed"] = time.perf_counter() - start
     ran = {k: v for k, v in data["joints"].items() if "runs" in v}
-    (RESULTS / "work_precision.json").write_text(json.dumps(data, indent=1))
+    (RESULTS / f"{stem}.json").write_text(json.dumps(data, indent=1))
     if ran:
-        plot({**data, "joints": ran}, RESULTS / "work_precision.png")
-        plot_tolerance({**data, "joints": ran}, RESULTS / "work_precision_tolerance.png")
-        (RESULTS / "work_precision.md").write_text(markdown({**data, "joints": ran}))
+        plot({**data, "joints": ran}, RESULTS / f"{stem}.png")
+        plot_tolerance({**data, "joints": ran}, RESULTS / f"{stem}_tolerance.png")
+        (RESULTS / f"{stem}.md").write_text(markdown({**data, "joints": ran}))
     log(f"\nRecommendation (cheapest setting with max pin-force error <= {PIN_TOLERANCE:.1%} of the peak):")
     for name, block in ran.items():
         for integ, rec in block["recommendation"].items():
             log(f"  {name:9s} {integ:18s} " + ("none of the settings" if rec is None else
                 f"{rec['setting']:22s} {rec['wall_time']:.3f} s (error {rec['pin_max_rel']:.1e})"))
-    log(f"\nwrote {RESULTS}/work_precision.{{json,md,png}}, work_precision_tolerance.png in {data['elapsed']:.0f} s")
+    log(f"\nwrote {RESULTS}/{stem}.{{json,md,png}}, {stem}_tolerance.png in {data['elapsed']:.0f} s")
 
 
 if __name__ == "__main__":
