@@ -45,6 +45,35 @@ def _resolve_options(options: Options | None, integrator: str | None, changes: d
     return options.replace(**given) if given else options
 
 
+#: The default integrator of a scene with roller bearings (the physical preset), where the
+#: paper scene's default (generalized-alpha, dt 1e-4 s) is off by 3 % of the peak pin force:
+#: dopri5 at atol 1e-8 m, rtol 1e-4, 3.9e-4 of the peak, the cheapest setting below 1e-3 with a
+#: margin in the work-precision benchmark of that preset (BENCHMARKS.md section 1.1).
+ROLLER_DEFAULT: dict[str, Any] = {"integrator": "dopri5", "atol": 1e-8, "rtol": 1e-4}
+
+
+def _has_rollers(scene: Scene) -> bool:
+    joints = scene.to_dict()["joints"]
+    return joints.get("kind") == "compliant" and any(
+        (joints.get(b) or {}).get("rollers") is not None for b in ("eccentric_bearing", "crank_bearing"))
+
+
+def _scene_defaults(scenes: Sequence[Scene], options: Options | None, integrator: str | None,
+                    changes: dict[str, Any]) -> tuple[str | None, dict[str, Any]]:
+    """The integrator and tolerances a call uses when it names none: ``ROLLER_DEFAULT`` for
+    scenes with roller bearings (unless ``options``, ``integrator`` or a step ``dt`` is given),
+    the library's defaults otherwise."""
+    if options is not None or integrator is not None or changes.get("dt") is not None:
+        return integrator, changes
+    if not any(_has_rollers(s) for s in scenes):
+        return integrator, changes
+    out = dict(changes)
+    for key in ("atol", "rtol"):
+        if out.get(key) is None:
+            out[key] = ROLLER_DEFAULT[key]
+    return str(ROLLER_DEFAULT["integrator"]), out
+
+
 def _warn(stats: dict[str, Any]) -> None:
     """Issue the run's accuracy warnings (a fixed step too long for the scene) as
     ``RuntimeWarning`` and keep them out of the numeric statistics."""
@@ -75,7 +104,10 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     controller, initial step ``dt``, default 1e-5 s), ``"dopri5"``
     (adaptive Dormand-Prince 5(4); ``atol`` [m] bounds displacement errors, default 1e-9 m;
     ``rtol`` relative velocity tolerance, default 1e-6) or ``"rk4"`` (fixed step ``dt``,
-    default 1e-5 s).
+    default 1e-5 s). Without ``integrator``, ``options`` or ``dt``, a scene with roller bearings
+    (``Scene.physical``) runs dopri5 at atol 1e-8 m, rtol 1e-4 (``ROLLER_DEFAULT``: 3.9e-4 of the
+    peak pin force, where generalized-alpha at dt 1e-4 s is off by 3 %); other scenes
+    generalized-alpha.
     record_interval: sample spacing [s] (default 1e-4 s), coarsened so that at most
     ``max_samples`` (default 50 000) samples are kept, which bounds memory on long runs.
     channels: any of ``"motion"``, ``"pins"``, ``"contact_points"``, ``"mesh"``, ``"energy"``,
@@ -99,10 +131,11 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     ((11,), 'generalized-alpha', 10)
     """
     scene = _check_scene(scene)
-    opts = _resolve_options(options, integrator, {
+    integrator, changes = _scene_defaults([scene], options, integrator, {
         "dt": dt, "rtol": rtol, "atol": atol, "rho_inf": rho_inf, "record_interval": record_interval,
         "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated,
         "step_check": step_check, "h_min": h_min, "max_steps": max_steps})
+    opts = _resolve_options(options, integrator, changes)
     t = _t_end(t_end)
     if progress is None:
         progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
@@ -153,10 +186,11 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
             raise ParameterError("give either a list of scenes or one scene with a grid, not both")
         scene_list = [_check_scene(s) for s in scenes]
         points = [{} for _ in scene_list]
-    opts = _resolve_options(options, integrator, {
+    integrator, changes = _scene_defaults(scene_list, options, integrator, {
         "dt": dt, "rtol": rtol, "atol": atol, "rho_inf": rho_inf, "record_interval": record_interval,
         "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated,
         "step_check": step_check, "h_min": h_min, "max_steps": max_steps})
+    opts = _resolve_options(options, integrator, changes)
     t = _t_end(t_end)
     used = opts.resolved(t)
     if threads is not None:
