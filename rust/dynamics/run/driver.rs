@@ -4,7 +4,7 @@ use crate::dynamics::model::ReducerModel;
 use crate::dynamics::model::rigid::RigidModel;
 use crate::dynamics::model::rigid_system::RigidSystem;
 use crate::dynamics::run::recorder::{Channel, Recorder, Recording};
-use crate::dynamics::scene::{Joints, Scene};
+use crate::dynamics::scene::{ContactLawSpec, Joints, Scene};
 use crate::error::{Result, RvdynError};
 use crate::solve::{Integrator, Method, Settings, State};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -271,13 +271,24 @@ fn checked_run<M: ReducerModel>(
 /// paper scenes are off by about 0.1 % of their peak (BENCHMARKS.md, work-precision).
 pub const STEPS_PER_MESH_PERIOD: f64 = 8.0;
 
+/// Steps per stiffness ramp of an ISO 6336 mesh below which a fixed step is reported:
+/// measured on the physical preset (ramp 0.02 of a base pitch, 48.9 us at its input speed),
+/// generalized-alpha at 4.9 steps per ramp is off by 1.1e-3 of the peak pin force and at 9.8
+/// steps by 3.7e-4 (BENCHMARKS.md section 1.1).
+pub const STEPS_PER_MESH_RAMP: f64 = 8.0;
+
 /// Why a fixed step `dt` cannot be accurate for `scene`, if it cannot (empty for an adaptive
-/// method): fewer than [`STEPS_PER_MESH_PERIOD`] steps per pin-mesh period
-/// `2 pi |i| / (zp zc w_in)` (docs/model.md, pin-pass frequency; a prescribed input speed `w_in`
-/// only). The pin pass is the highest frequency that excites the model (the sun/planet mesh
-/// stiffness is constant); the linearised modes above it respond quasi-statically, and
-/// generalized-alpha damps them (an explicit method's step is bounded by them instead: the
-/// RK4 stability check, dopri5's stiffness detection).
+/// method), with a prescribed input speed `w_in`:
+/// - fewer than [`STEPS_PER_MESH_PERIOD`] steps per pin-mesh period `2 pi |i| / (zp zc w_in)`
+///   (docs/model.md, pin-pass frequency). With the paper's constant mesh stiffness the pin
+///   pass is the highest frequency that excites the model; the linearised modes above it
+///   respond quasi-statically, and generalized-alpha damps them (an explicit method's step is
+///   bounded by them instead: the RK4 stability check, dopri5's stiffness detection);
+/// - with an ISO 6336 mesh, fewer than [`STEPS_PER_MESH_RAMP`] steps per stiffness ramp, the
+///   ramp being its width (a fraction of the base pitch) times the mesh period
+///   `2 pi / (z_sun |w_in - w_carrier|)` (docs/model.md, "Time variation along the line of
+///   action"). This is necessary, not sufficient: the lightly damped modes such a scene
+///   usually has need short steps too (BENCHMARKS.md section 1.1).
 pub fn fixed_step_warnings(scene: &Scene, opt: &SimOptions) -> Result<Vec<String>> {
     if opt.method.0.adaptive {
         return Ok(Vec::new());
@@ -298,6 +309,22 @@ pub fn fixed_step_warnings(scene: &Scene, opt: &SimOptions) -> Result<Vec<String
                 period,
                 period / STEPS_PER_MESH_PERIOD
             ));
+        }
+        if let (ContactLawSpec::Iso6336 { ramp, .. }, Some(stage)) =
+            (&scene.contact.mesh, &scene.stage1)
+        {
+            let relative = speed.abs() * (1.0 - 1.0 / scene.ratio()).abs();
+            let ramp_time = ramp * 2.0 * std::f64::consts::PI / (f64::from(stage.z_sun) * relative);
+            if ramp_time.is_finite() && dt * STEPS_PER_MESH_RAMP > ramp_time {
+                out.push(format!(
+                    "{name} with dt = {dt:.3e} s takes {:.1} steps per stiffness ramp of the \
+                     ISO 6336 mesh ({ramp_time:.3e} s at the input speed): the pin forces can be \
+                     off by more than 0.1 % of their peak; use dt <= {:.1e} s or \
+                     integrator=\"dopri5\"",
+                    ramp_time / dt,
+                    ramp_time / STEPS_PER_MESH_RAMP
+                ));
+            }
         }
     }
     Ok(out)
@@ -569,5 +596,32 @@ mod tests {
                 "{saved} saved, {at_ends} samples at step ends, {split} splits"
             );
         }
+    }
+
+    /// The ISO mesh's stiffness ramp: the physical preset (ramp 48.9 us at its input speed)
+    /// warns at the default 1e-4 s and at 1e-5 s (4.9 steps per ramp, measured 1.1e-3 of the
+    /// peak pin force), not at 5e-6 s (9.8 steps, 3.7e-4); the paper scene (constant mesh
+    /// stiffness) and the adaptive methods get no ramp warning.
+    #[test]
+    fn a_fixed_step_longer_than_the_iso_mesh_ramp_allows_is_reported() {
+        let ramp_warnings = |scene: &Scene, method: &str, dt: f64| {
+            let mut opt = SimOptions::new(1.0, Method::parse(method).unwrap());
+            opt.dt = Some(dt);
+            fixed_step_warnings(scene, &opt)
+                .unwrap()
+                .into_iter()
+                .filter(|w| w.contains("stiffness ramp"))
+                .collect::<Vec<_>>()
+        };
+        let physical = Scene::physical("rated").unwrap();
+        for dt in [1e-4, 1e-5] {
+            let w = ramp_warnings(&physical, "generalized-alpha", dt);
+            assert_eq!(w.len(), 1, "dt {dt}: {w:?}");
+            assert!(w[0].contains("(4.889e-5 s at the input speed)"), "{}", w[0]);
+        }
+        assert!(ramp_warnings(&physical, "generalized-alpha", 5e-6).is_empty());
+        assert!(ramp_warnings(&physical, "generalized-alpha-adaptive", 1e-4).is_empty());
+        let paper = Scene::paper("rated").unwrap();
+        assert!(ramp_warnings(&paper, "generalized-alpha", 1e-4).is_empty());
     }
 }
