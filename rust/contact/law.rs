@@ -9,6 +9,7 @@ use crate::contact::damping::{HysteresisDamping, HysteresisModel, StiffnessPropo
 use crate::contact::hertz::Material;
 use crate::contact::impact::ImpactLaw;
 use crate::contact::line_contact::{LineContactLaw, disc_reference_depth};
+use crate::contact::pin_tangent::{centre_curve_derivatives, curvature_derivatives_of};
 use crate::error::{Result, RvdynError, require_positive};
 use crate::gear::iso6336::{IsoGearPair, MeshStiffnessWave, base_pitch, spur_contact_ratio};
 use crate::geometry::CycloidGeometry;
@@ -278,17 +279,11 @@ impl PinLaw {
         }
         let g = site.geometry;
         let r = g.generating_pin_radius();
-        // The curve's jet at the contact, used twice: the curvature (as
-        // `CycloidGeometry::centre_curve_curvature`) and the foot sensitivity below.
-        let j = g.jet(site.phi);
-        let kc = {
-            let cross = j.d1[0] * j.d2[1] - j.d1[1] * j.d2[0];
-            let len = j.d1[0].hypot(j.d1[1]);
-            cross / (len * len * len)
-        };
-        let h = 1e-6;
-        let dkc = (g.centre_curve_curvature(site.phi + h) - g.centre_curve_curvature(site.phi - h))
-            / (2.0 * h);
+        // The curve's derivatives at the contact, used twice: the curvature and its slope
+        // (`curvature_derivatives_of`, exact) and the foot sensitivity below.
+        let d = centre_curve_derivatives(g, site.phi);
+        let [kc, dkc, _] = curvature_derivatives_of(&d);
+        let [c, d1, d2, ..] = d;
         let den = 1.0 - r * kc;
         let k2 = kc / den;
         let dk2 = dkc / (den * den);
@@ -305,21 +300,18 @@ impl PinLaw {
             pin_centre[1] - disc_centre[1],
         ];
         let p = g.remove_rotation_mod([cs * d[0] + sn * d[1], -sn * d[0] + cs * d[1]]);
-        let gp = j.d1[0] * j.d1[0]
-            + j.d1[1] * j.d1[1]
-            + (j.c[0] - p[0]) * j.d2[0]
-            + (j.c[1] - p[1]) * j.d2[1];
+        let gp = d1[0] * d1[0] + d1[1] * d1[1] + (c[0] - p[0]) * d2[0] + (c[1] - p[1]) * d2[1];
         if gp.is_nan() || gp <= 0.0 {
             return None;
         }
-        let t = g.apply_rotation_mod(j.d1);
+        let t = g.apply_rotation_mod(d1);
         let t_global = [cs * t[0] - sn * t[1], sn * t[0] + cs * t[1]];
         // dp/dtheta = -z x p; dp/dO = -R(-theta) (mod removed).
         let zxp = [-p[1], p[0]];
         Some(LocationSlope {
             energy_per_phi,
             phi_per_centre: [-t_global[0] / gp, -t_global[1] / gp],
-            phi_per_angle: -(j.d1[0] * zxp[0] + j.d1[1] * zxp[1]) / gp,
+            phi_per_angle: -(d1[0] * zxp[0] + d1[1] * zxp[1]) / gp,
         })
     }
 }
