@@ -8,7 +8,10 @@
 use crate::contact::damping::{HysteresisDamping, HysteresisModel, StiffnessProportionalDamping};
 use crate::contact::hertz::Material;
 use crate::contact::impact::ImpactLaw;
-use crate::contact::line_contact::{LineContactLaw, disc_reference_depth};
+use crate::contact::line_contact::{
+    LineContactLaw, PinDiscLawBase, disc_reference_depth, disc_reference_depth_ratio,
+    profile_curvature_checked,
+};
 use crate::contact::pin_tangent::{centre_curve_derivatives, curvature_derivatives_of};
 use crate::error::{Result, RvdynError, require_positive};
 use crate::gear::iso6336::{IsoGearPair, MeshStiffnessWave, base_pitch, spur_contact_ratio};
@@ -238,6 +241,42 @@ impl PinLaw {
         }
     }
 
+    /// As [`PinLaw::evaluate_warm`] for the line law with the contact's law built from its
+    /// prepared part `base` (checked with the scene), `ln` of the disc's body depth `ln_depth`
+    /// and the pin-centre curve's curvature `kappa_c` \[1/m\] at the contact: one logarithm
+    /// instead of a curve evaluation and three (the same law to round-off:
+    /// [`PinDiscLawBase::law`]). The IMPACT law ignores them.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn evaluate_prepared(
+        &self,
+        pen: f64,
+        rate: f64,
+        site: &PinSite<'_>,
+        want_energy: bool,
+        ln_force_guess: f64,
+        (base, ln_depth, kappa_c): (&PinDiscLawBase, f64, f64),
+    ) -> Result<(LawForce, f64)> {
+        let PinLaw::Line { damping, .. } = self else {
+            return self.evaluate_warm(pen, rate, site, want_energy, ln_force_guess);
+        };
+        let kappa = profile_curvature_checked(kappa_c, site.geometry.generating_pin_radius())?;
+        let (depth, ratio) = disc_reference_depth_ratio(kappa, site.depth);
+        let law = base.law(kappa, depth.depth, ln_depth - ratio)?;
+        let (fe, k, ln_f) = law.force_and_stiffness_from(pen, ln_force_guess);
+        Ok((
+            LawForce {
+                force: damping.force(fe, k, rate),
+                elastic: fe,
+                energy: if want_energy {
+                    law.elastic_energy(pen)
+                } else {
+                    0.0
+                },
+            },
+            ln_f,
+        ))
+    }
+
     /// The line law's energy depends on where the pin touches the profile (the curvature
     /// sets `K0`, see `contact::line_contact`), so a conservative force field needs, besides
     /// the normal force, the term `-dU/dphi dphi/dq`. With `delta = F (K0 - K1 ln F)`,
@@ -269,6 +308,38 @@ impl PinLaw {
         site: &PinSite<'_>,
         pin_centre: [f64; 2],
         disc_centre: [f64; 2],
+        sin_cos: (f64, f64),
+    ) -> Option<LocationSlope> {
+        if elastic <= 0.0 || !matches!(self, PinLaw::Line { .. }) {
+            return None;
+        }
+        // The curve's derivatives at the contact, used twice: the curvature and its slope
+        // (exact) and the foot sensitivity.
+        let d = centre_curve_derivatives(site.geometry, site.phi);
+        let [kc, dkc, _] = curvature_derivatives_of(&d);
+        self.location_slope_from(
+            elastic,
+            site,
+            &d,
+            [kc, dkc],
+            pin_centre,
+            disc_centre,
+            sin_cos,
+        )
+    }
+
+    /// As [`PinLaw::location_slope_at`] with the curve derivatives `d` (orders 0-4) at the
+    /// contact and the curvature `kappa_c` with its slope in `phi` given.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub(crate) fn location_slope_from(
+        &self,
+        elastic: f64,
+        site: &PinSite<'_>,
+        d: &[[f64; 2]; 5],
+        [kc, dkc]: [f64; 2],
+        pin_centre: [f64; 2],
+        disc_centre: [f64; 2],
         (sn, cs): (f64, f64),
     ) -> Option<LocationSlope> {
         let PinLaw::Line { pin, disc, .. } = self else {
@@ -279,11 +350,7 @@ impl PinLaw {
         }
         let g = site.geometry;
         let r = g.generating_pin_radius();
-        // The curve's derivatives at the contact, used twice: the curvature and its slope
-        // (`curvature_derivatives_of`, exact) and the foot sensitivity below.
-        let d = centre_curve_derivatives(g, site.phi);
-        let [kc, dkc, _] = curvature_derivatives_of(&d);
-        let [c, d1, d2, ..] = d;
+        let [c, d1, d2, ..] = *d;
         let den = 1.0 - r * kc;
         let k2 = kc / den;
         let dk2 = dkc / (den * den);

@@ -2,6 +2,7 @@
 //! Shared by the rigid- and compliant-joint models.
 
 use crate::contact::law::{LawForce, PinLaw, PinSite};
+use crate::contact::line_contact::PinDiscLawBase;
 use crate::dynamics::model::parts::{DiscModel, PinModel};
 use crate::error::{Result, RvdynError};
 use crate::geometry::gap::{FootOrOpen, small_sin_cos};
@@ -422,6 +423,25 @@ pub(crate) fn pin_law_force(
     }
 }
 
+/// As [`pin_law_force`] with the line law built from its prepared part (see
+/// [`PinLaw::evaluate_prepared`]): `(base, ln body depth, curvature of the pin-centre curve
+/// at the contact)`.
+pub(crate) fn pin_law_force_prepared(
+    law: &PinLaw,
+    pen: f64,
+    rate: f64,
+    site: &PinSite<'_>,
+    want_energy: bool,
+    warm: &Cell<WarmStart>,
+    prepared: (&PinDiscLawBase, f64, f64),
+) -> Result<LawForce> {
+    let mut ws = warm.get();
+    let (lf, ln_f) = law.evaluate_prepared(pen, rate, site, want_energy, ws.ln_force, prepared)?;
+    ws.ln_force = ln_f;
+    warm.set(ws);
+    Ok(lf)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -433,7 +453,8 @@ mod tests {
     /// The models' line law (checked once, inversion warm-started from the pin's last `ln F`)
     /// gives the force of the fully checked `PinLaw::evaluate` to 1e-14 relative, from any
     /// earlier force (none, far below, far above, the previous one), over the profile and from
-    /// 1e-9 m to 1e-4 m of approach.
+    /// 1e-9 m to 1e-4 m of approach; so does the compliant model's law built from its
+    /// prepared part.
     #[test]
     fn warm_started_line_law_gives_the_checked_force() {
         let g = CycloidGeometry::new(CycloidParams::paper()).unwrap();
@@ -475,6 +496,27 @@ mod tests {
                         );
                     }
                     assert!((warm.get().ln_force - want.elastic.ln()).abs() < 1e-13);
+                    // The compliant model's prepared law: the same force to 1e-14 (its
+                    // curvature from the curve derivatives, the law from the pin's base).
+                    let base = PinDiscLawBase::new(0.010, g.params().face_width, &s, &s);
+                    let d = crate::contact::pin_tangent::centre_curve_derivatives(&g, phi);
+                    let kc = crate::contact::pin_tangent::curvature_derivatives_of(&d)[0];
+                    let mut w = warm.get();
+                    w.ln_force = guess;
+                    warm.set(w);
+                    let prepared = (&base, site.depth.ln(), kc);
+                    let got = pin_law_force_prepared(&law, pen, 1e-3, &site, true, &warm, prepared)
+                        .unwrap();
+                    for (a, b) in [
+                        (got.force, want.force),
+                        (got.elastic, want.elastic),
+                        (got.energy, want.energy),
+                    ] {
+                        assert!(
+                            (a - b).abs() <= 1e-14 * b.abs(),
+                            "prepared {phi} {pen} {guess}: {a} {b}"
+                        );
+                    }
                 }
             }
         }

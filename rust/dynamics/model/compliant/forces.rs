@@ -3,8 +3,9 @@
 
 use super::{CARRIER, CompliantModel, Flows, SUN, crank_index};
 use crate::contact::law::{PinLaw, PinSite};
+use crate::contact::pin_tangent::{centre_curve_derivatives, curvature_derivatives_of};
 use crate::dynamics::model::pin_contact::{
-    DiscPose, penetration_error, pin_law_force, touching_pin,
+    DiscPose, penetration_error, pin_law_force, pin_law_force_prepared, touching_pin,
 };
 use crate::dynamics::model::vec2::{add, cross, dot, perp, rotate, scaled, sub};
 use crate::dynamics::run::sink::ContactSink;
@@ -208,7 +209,25 @@ impl CompliantModel {
                     pin_radius: pin.radius,
                     depth: disc.body_depth,
                 };
-                let lf = pin_law_force(&m.pin_law, pen, pen_rate, &site, want_energy, warm)?;
+                // The line law's curvature, and its slope for the location term, from one set
+                // of curve derivatives at the contact.
+                let line = matches!(m.pin_law, PinLaw::Line { .. }).then(|| {
+                    let d = centre_curve_derivatives(&disc.geometry, pc.phi);
+                    let [kc, dkc, _] = curvature_derivatives_of(&d);
+                    (d, [kc, dkc])
+                });
+                let lf = match &line {
+                    Some((_, [kc, _])) => pin_law_force_prepared(
+                        &m.pin_law,
+                        pen,
+                        pen_rate,
+                        &site,
+                        want_energy,
+                        warm,
+                        (&self.line_bases[idx], self.ln_depths[k], *kc),
+                    )?,
+                    None => pin_law_force(&m.pin_law, pen, pen_rate, &site, want_energy, warm)?,
+                };
                 let f = lf.force;
                 qf[dk] -= f * n[0];
                 qf[dk + 1] -= f * n[1];
@@ -235,10 +254,12 @@ impl CompliantModel {
                 }
                 // Location term of a line law (see `PinLaw::location_slope`; tested for the law
                 // here, not in the call, so that the IMPACT law's evaluations skip the call).
-                if matches!(m.pin_law, PinLaw::Line { .. })
-                    && let Some(ls) = m.pin_law.location_slope_at(
+                if let Some((d, curvature)) = &line
+                    && let Some(ls) = m.pin_law.location_slope_from(
                         lf.elastic,
                         &site,
+                        d,
+                        *curvature,
                         pin.centre,
                         o,
                         (pose.sin, pose.cos),

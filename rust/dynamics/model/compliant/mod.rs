@@ -41,6 +41,8 @@ use std::cell::Cell;
 use std::f64::consts::TAU;
 
 use crate::bearing::PalmgrenFriction;
+use crate::contact::law::PinLaw;
+use crate::contact::line_contact::PinDiscLawBase;
 use crate::dynamics::model::laws::BearingLaw;
 pub use crate::dynamics::model::laws::{BearingLoad, linear_bearing as bearing_load};
 use crate::dynamics::model::parts::Parts;
@@ -127,6 +129,11 @@ pub struct CompliantModel {
     /// Foot parameter of each (disc, pin) contact at the last evaluation (Newton warm start;
     /// the contact found does not depend on it).
     warm_seeds: Vec<Cell<WarmStart>>,
+    /// The line law's contact-independent part of each (disc, pin) contact and `ln` of each
+    /// disc's body depth (empty for other pin laws), prepared once: the law at a contact
+    /// then takes one logarithm ([`PinDiscLawBase`]).
+    line_bases: Vec<PinDiscLawBase>,
+    ln_depths: Vec<f64>,
     /// Skip the exact query of a pin that provably cannot touch ([`SeparationBound`]).
     pub(crate) skip_separated: bool,
     separation: Vec<Cell<SeparationBound>>,
@@ -293,6 +300,21 @@ impl CompliantModel {
             .collect();
         let scale = coords.iter().map(|&i| lever[i]).collect();
         let base_skip = base.discs.iter().all(|d| d.profile_error.is_none());
+        let (line_bases, ln_depths) = match &base.pin_law {
+            PinLaw::Line { pin, disc, .. } => (
+                base.discs
+                    .iter()
+                    .flat_map(|d| {
+                        let width = d.geometry.params().face_width;
+                        base.pins
+                            .iter()
+                            .map(move |p| PinDiscLawBase::new(p.radius, width, pin, disc))
+                    })
+                    .collect(),
+                base.discs.iter().map(|d| d.body_depth.ln()).collect(),
+            ),
+            PinLaw::Impact(_) => (Vec::new(), Vec::new()),
+        };
         Ok(Self {
             parts: base,
             eccentric_bearing: BearingLaw::new(&eccentric_bearing)?,
@@ -308,6 +330,8 @@ impl CompliantModel {
             input,
             scale,
             warm_seeds: vec![Cell::new(WarmStart::default()); nd * zp],
+            line_bases,
+            ln_depths,
             // The separation bound assumes a rigid profile; a profile error's first-order
             // offset is not one: query every pin.
             skip_separated: base_skip,
