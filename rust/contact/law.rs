@@ -152,6 +152,35 @@ pub enum PinLaw {
     },
 }
 
+/// The line law `law`'s force at the approach `pen` \[m\] and approach rate `rate` \[m/s\]
+/// with `damping`, its inversion started from `ln_force_guess`; and `ln F` to keep as the next
+/// guess.
+#[inline]
+fn line_force(
+    law: &LineContactLaw,
+    damping: &ContactDamping,
+    pen: f64,
+    rate: f64,
+    want_energy: bool,
+    ln_force_guess: f64,
+) -> (LawForce, f64) {
+    let (fe, k, ln_f) = law.force_and_stiffness_from(pen, ln_force_guess);
+    let energy = if want_energy {
+        law.elastic_energy(pen)
+    } else {
+        0.0
+    };
+    let force = damping.force(fe, k, rate);
+    (
+        LawForce {
+            force,
+            elastic: fe,
+            energy,
+        },
+        ln_f,
+    )
+}
+
 impl PinLaw {
     /// Force at the approach `pen` \[m\] (> 0) and rate `rate` [m/s] at the contact `site`.
     ///
@@ -224,18 +253,13 @@ impl PinLaw {
                     pin,
                     disc,
                 )?;
-                let (fe, k, ln_f) = law.force_and_stiffness_from(pen, ln_force_guess);
-                Ok((
-                    LawForce {
-                        force: damping.force(fe, k, rate),
-                        elastic: fe,
-                        energy: if want_energy {
-                            law.elastic_energy(pen)
-                        } else {
-                            0.0
-                        },
-                    },
-                    ln_f,
+                Ok(line_force(
+                    &law,
+                    damping,
+                    pen,
+                    rate,
+                    want_energy,
+                    ln_force_guess,
                 ))
             }
         }
@@ -262,18 +286,13 @@ impl PinLaw {
         let kappa = profile_curvature_checked(kappa_c, site.geometry.generating_pin_radius())?;
         let (depth, ratio) = disc_reference_depth_ratio(kappa, site.depth);
         let law = base.law(kappa, depth.depth, ln_depth - ratio)?;
-        let (fe, k, ln_f) = law.force_and_stiffness_from(pen, ln_force_guess);
-        Ok((
-            LawForce {
-                force: damping.force(fe, k, rate),
-                elastic: fe,
-                energy: if want_energy {
-                    law.elastic_energy(pen)
-                } else {
-                    0.0
-                },
-            },
-            ln_f,
+        Ok(line_force(
+            &law,
+            damping,
+            pen,
+            rate,
+            want_energy,
+            ln_force_guess,
         ))
     }
 

@@ -401,7 +401,9 @@ pub(crate) fn touching_pin(
 
 /// The force of `law` on a touching pin at `site` (approach `pen` \[m\], rate `rate` [m/s]), as
 /// [`PinLaw::evaluate`]; a line law's inversion starts from the `ln F` this pin had at the
-/// previous evaluation (kept in `warm`), which saves Newton iterations and not accuracy.
+/// previous evaluation (kept in `warm`), which saves Newton iterations and not accuracy. With
+/// `prepared`, `(base, ln body depth, curvature of the pin-centre curve at the contact)`, the
+/// line law is built from its prepared part ([`PinLaw::evaluate_prepared`]).
 #[inline]
 pub(crate) fn pin_law_force(
     law: &PinLaw,
@@ -410,33 +412,16 @@ pub(crate) fn pin_law_force(
     site: &PinSite<'_>,
     want_energy: bool,
     warm: &Cell<WarmStart>,
+    prepared: Option<(&PinDiscLawBase, f64, f64)>,
 ) -> Result<LawForce> {
-    match law {
-        PinLaw::Impact(_) => law.evaluate(pen, rate, site, want_energy),
-        PinLaw::Line { .. } => {
-            let mut ws = warm.get();
-            let (lf, ln_f) = law.evaluate_warm(pen, rate, site, want_energy, ws.ln_force)?;
-            ws.ln_force = ln_f;
-            warm.set(ws);
-            Ok(lf)
-        }
+    if let PinLaw::Impact(_) = law {
+        return law.evaluate(pen, rate, site, want_energy);
     }
-}
-
-/// As [`pin_law_force`] with the line law built from its prepared part (see
-/// [`PinLaw::evaluate_prepared`]): `(base, ln body depth, curvature of the pin-centre curve
-/// at the contact)`.
-pub(crate) fn pin_law_force_prepared(
-    law: &PinLaw,
-    pen: f64,
-    rate: f64,
-    site: &PinSite<'_>,
-    want_energy: bool,
-    warm: &Cell<WarmStart>,
-    prepared: (&PinDiscLawBase, f64, f64),
-) -> Result<LawForce> {
     let mut ws = warm.get();
-    let (lf, ln_f) = law.evaluate_prepared(pen, rate, site, want_energy, ws.ln_force, prepared)?;
+    let (lf, ln_f) = match prepared {
+        Some(p) => law.evaluate_prepared(pen, rate, site, want_energy, ws.ln_force, p)?,
+        None => law.evaluate_warm(pen, rate, site, want_energy, ws.ln_force)?,
+    };
     ws.ln_force = ln_f;
     warm.set(ws);
     Ok(lf)
@@ -484,17 +469,22 @@ mod tests {
                     let mut w = warm.get();
                     w.ln_force = guess;
                     warm.set(w);
-                    let got = pin_law_force(&law, pen, 1e-3, &site, true, &warm).unwrap();
-                    for (a, b) in [
-                        (got.force, want.force),
-                        (got.elastic, want.elastic),
-                        (got.energy, want.energy),
-                    ] {
-                        assert!(
-                            (a - b).abs() <= 1e-14 * b.abs(),
-                            "{phi} {pen} {guess}: {a} {b}"
-                        );
-                    }
+                    let same = |got: LawForce, what: &str| {
+                        for (a, b) in [
+                            (got.force, want.force),
+                            (got.elastic, want.elastic),
+                            (got.energy, want.energy),
+                        ] {
+                            assert!(
+                                (a - b).abs() <= 1e-14 * b.abs(),
+                                "{what} {phi} {pen} {guess}: {a} {b}"
+                            );
+                        }
+                    };
+                    same(
+                        pin_law_force(&law, pen, 1e-3, &site, true, &warm, None).unwrap(),
+                        "warm",
+                    );
                     assert!((warm.get().ln_force - want.elastic.ln()).abs() < 1e-13);
                     // The compliant model's prepared law: the same force to 1e-14 (its
                     // curvature from the curve derivatives, the law from the pin's base).
@@ -505,18 +495,8 @@ mod tests {
                     w.ln_force = guess;
                     warm.set(w);
                     let prepared = (&base, site.depth.ln(), kc);
-                    let got = pin_law_force_prepared(&law, pen, 1e-3, &site, true, &warm, prepared)
-                        .unwrap();
-                    for (a, b) in [
-                        (got.force, want.force),
-                        (got.elastic, want.elastic),
-                        (got.energy, want.energy),
-                    ] {
-                        assert!(
-                            (a - b).abs() <= 1e-14 * b.abs(),
-                            "prepared {phi} {pen} {guess}: {a} {b}"
-                        );
-                    }
+                    let got = pin_law_force(&law, pen, 1e-3, &site, true, &warm, Some(prepared));
+                    same(got.unwrap(), "prepared");
                 }
             }
         }

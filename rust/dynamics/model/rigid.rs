@@ -297,7 +297,8 @@ impl RigidModel {
                     pin_radius: pin.radius,
                     depth: d.body_depth,
                 };
-                let lf = pin_law_force(&self.pin_law, pen, pen_rate, &site, want_energy, warm)?;
+                let lf =
+                    pin_law_force(&self.pin_law, pen, pen_rate, &site, want_energy, warm, None)?;
                 let f = lf.force;
                 out.q[CARRIER] -= f * lever_c;
                 out.q[CRANK] -= f * lever_a;

@@ -5,7 +5,7 @@ use super::{CARRIER, CompliantModel, Flows, SUN, crank_index};
 use crate::contact::law::{PinLaw, PinSite};
 use crate::contact::pin_tangent::{centre_curve_derivatives, curvature_derivatives_of};
 use crate::dynamics::model::pin_contact::{
-    DiscPose, penetration_error, pin_law_force, pin_law_force_prepared, touching_pin,
+    DiscPose, penetration_error, pin_law_force, touching_pin,
 };
 use crate::dynamics::model::vec2::{add, cross, dot, perp, rotate, scaled, sub};
 use crate::dynamics::run::sink::ContactSink;
@@ -216,18 +216,18 @@ impl CompliantModel {
                     let [kc, dkc, _] = curvature_derivatives_of(&d);
                     (d, [kc, dkc])
                 });
-                let lf = match &line {
-                    Some((_, [kc, _])) => pin_law_force_prepared(
-                        &m.pin_law,
-                        pen,
-                        pen_rate,
-                        &site,
-                        want_energy,
-                        warm,
-                        (&self.line_bases[idx], self.ln_depths[k], *kc),
-                    )?,
-                    None => pin_law_force(&m.pin_law, pen, pen_rate, &site, want_energy, warm)?,
-                };
+                let prepared = line
+                    .as_ref()
+                    .map(|(_, [kc, _])| (&self.line_bases[idx], self.ln_depths[k], *kc));
+                let lf = pin_law_force(
+                    &m.pin_law,
+                    pen,
+                    pen_rate,
+                    &site,
+                    want_energy,
+                    warm,
+                    prepared,
+                )?;
                 let f = lf.force;
                 qf[dk] -= f * n[0];
                 qf[dk + 1] -= f * n[1];
