@@ -152,35 +152,6 @@ pub enum PinLaw {
     },
 }
 
-/// The line law `law`'s force at the approach `pen` \[m\] and approach rate `rate` \[m/s\]
-/// with `damping`, its inversion started from `ln_force_guess`; and `ln F` to keep as the next
-/// guess.
-#[inline]
-fn line_force(
-    law: &LineContactLaw,
-    damping: &ContactDamping,
-    pen: f64,
-    rate: f64,
-    want_energy: bool,
-    ln_force_guess: f64,
-) -> (LawForce, f64) {
-    let (fe, k, ln_f) = law.force_and_stiffness_from(pen, ln_force_guess);
-    let energy = if want_energy {
-        law.elastic_energy(pen)
-    } else {
-        0.0
-    };
-    let force = damping.force(fe, k, rate);
-    (
-        LawForce {
-            force,
-            elastic: fe,
-            energy,
-        },
-        ln_f,
-    )
-}
-
 impl PinLaw {
     /// Force at the approach `pen` \[m\] (> 0) and rate `rate` [m/s] at the contact `site`.
     ///
@@ -233,6 +204,11 @@ impl PinLaw {
     /// the same force to round-off (the inversion converges to 1e-15, see
     /// [`LineContactLaw::force_and_stiffness_from`]), in fewer iterations. Returns the force and
     /// `ln F` to keep as the next guess (NaN for IMPACT).
+    ///
+    /// With `prepared = (base, ln_depth, kappa_c)` the line law at the contact is built from its
+    /// prepared part `base` (checked with the scene), `ln` of the disc's body depth and the
+    /// pin-centre curve's curvature `kappa_c` \[1/m\] at the contact: one logarithm instead of
+    /// a curve evaluation and three (the same law to round-off: [`PinDiscLawBase::law`]).
     #[inline]
     pub(crate) fn evaluate_warm(
         &self,
@@ -241,58 +217,41 @@ impl PinLaw {
         site: &PinSite<'_>,
         want_energy: bool,
         ln_force_guess: f64,
+        prepared: Option<(&PinDiscLawBase, f64, f64)>,
     ) -> Result<(LawForce, f64)> {
-        match self {
-            PinLaw::Impact(_) => Ok((self.evaluate(pen, rate, site, want_energy)?, f64::NAN)),
-            PinLaw::Line { pin, disc, damping } => {
-                let law = LineContactLaw::cycloid_contact_checked(
-                    site.geometry,
-                    site.phi,
-                    site.pin_radius,
-                    site.depth,
-                    pin,
-                    disc,
-                )?;
-                Ok(line_force(
-                    &law,
-                    damping,
-                    pen,
-                    rate,
-                    want_energy,
-                    ln_force_guess,
-                ))
-            }
-        }
-    }
-
-    /// As [`PinLaw::evaluate_warm`] for the line law with the contact's law built from its
-    /// prepared part `base` (checked with the scene), `ln` of the disc's body depth `ln_depth`
-    /// and the pin-centre curve's curvature `kappa_c` \[1/m\] at the contact: one logarithm
-    /// instead of a curve evaluation and three (the same law to round-off:
-    /// [`PinDiscLawBase::law`]). The IMPACT law ignores them.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn evaluate_prepared(
-        &self,
-        pen: f64,
-        rate: f64,
-        site: &PinSite<'_>,
-        want_energy: bool,
-        ln_force_guess: f64,
-        (base, ln_depth, kappa_c): (&PinDiscLawBase, f64, f64),
-    ) -> Result<(LawForce, f64)> {
-        let PinLaw::Line { damping, .. } = self else {
-            return self.evaluate_warm(pen, rate, site, want_energy, ln_force_guess);
+        let PinLaw::Line { pin, disc, damping } = self else {
+            return Ok((self.evaluate(pen, rate, site, want_energy)?, f64::NAN));
         };
-        let kappa = profile_curvature_checked(kappa_c, site.geometry.generating_pin_radius())?;
-        let (depth, ratio) = disc_reference_depth_ratio(kappa, site.depth);
-        let law = base.law(kappa, depth.depth, ln_depth - ratio)?;
-        Ok(line_force(
-            &law,
-            damping,
-            pen,
-            rate,
-            want_energy,
-            ln_force_guess,
+        let law = match prepared {
+            Some((base, ln_depth, kappa_c)) => {
+                let r = site.geometry.generating_pin_radius();
+                let kappa = profile_curvature_checked(kappa_c, r)?;
+                let (depth, ratio) = disc_reference_depth_ratio(kappa, site.depth);
+                base.law(kappa, depth.depth, ln_depth - ratio)?
+            }
+            None => LineContactLaw::cycloid_contact_checked(
+                site.geometry,
+                site.phi,
+                site.pin_radius,
+                site.depth,
+                pin,
+                disc,
+            )?,
+        };
+        let (fe, k, ln_f) = law.force_and_stiffness_from(pen, ln_force_guess);
+        let energy = if want_energy {
+            law.elastic_energy(pen)
+        } else {
+            0.0
+        };
+        let force = damping.force(fe, k, rate);
+        Ok((
+            LawForce {
+                force,
+                elastic: fe,
+                energy,
+            },
+            ln_f,
         ))
     }
 

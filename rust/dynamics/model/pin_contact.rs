@@ -403,7 +403,7 @@ pub(crate) fn touching_pin(
 /// [`PinLaw::evaluate`]; a line law's inversion starts from the `ln F` this pin had at the
 /// previous evaluation (kept in `warm`), which saves Newton iterations and not accuracy. With
 /// `prepared`, `(base, ln body depth, curvature of the pin-centre curve at the contact)`, the
-/// line law is built from its prepared part ([`PinLaw::evaluate_prepared`]).
+/// line law is built from its prepared part ([`PinLaw::evaluate_warm`]).
 #[inline]
 pub(crate) fn pin_law_force(
     law: &PinLaw,
@@ -418,10 +418,7 @@ pub(crate) fn pin_law_force(
         return law.evaluate(pen, rate, site, want_energy);
     }
     let mut ws = warm.get();
-    let (lf, ln_f) = match prepared {
-        Some(p) => law.evaluate_prepared(pen, rate, site, want_energy, ws.ln_force, p)?,
-        None => law.evaluate_warm(pen, rate, site, want_energy, ws.ln_force)?,
-    };
+    let (lf, ln_f) = law.evaluate_warm(pen, rate, site, want_energy, ws.ln_force, prepared)?;
     ws.ln_force = ln_f;
     warm.set(ws);
     Ok(lf)
