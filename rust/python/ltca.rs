@@ -87,12 +87,12 @@ impl LtcaSolver {
     }
 
     /// TE over one mesh period at `points` crank angles from `start` [rad], at +-`torque` and
-    /// +-`light` [N m].
+    /// (unless `light` is None) +-`light` [N m], with each curve's extremes.
     fn transmission_error<'py>(
         &mut self,
         py: Python<'py>,
         torque: f64,
-        light: f64,
+        light: Option<f64>,
         points: usize,
         start: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
@@ -104,14 +104,34 @@ impl LtcaSolver {
         d.set_item("period", te.period)?;
         d.set_item("forward", f64_array(py, te.forward, vec![n])?)?;
         d.set_item("reverse", f64_array(py, te.reverse, vec![n])?)?;
+        // Empty without the unloaded curves.
+        let m = te.unloaded_forward.len();
         d.set_item(
             "unloaded_forward",
-            f64_array(py, te.unloaded_forward, vec![n])?,
+            f64_array(py, te.unloaded_forward, vec![m])?,
         )?;
         d.set_item(
             "unloaded_reverse",
-            f64_array(py, te.unloaded_reverse, vec![n])?,
+            f64_array(py, te.unloaded_reverse, vec![m])?,
         )?;
+        let x = &te.extremes;
+        let extremes = PyDict::new(py);
+        for (name, e) in [
+            ("forward", Some(x.forward)),
+            ("reverse", Some(x.reverse)),
+            ("unloaded_forward", x.unloaded_forward),
+            ("unloaded_reverse", x.unloaded_reverse),
+        ] {
+            let Some(e) = e else { continue };
+            let one = PyDict::new(py);
+            one.set_item("max_angle", e.max.crank_angle)?;
+            one.set_item("max", e.max.value)?;
+            one.set_item("min_angle", e.min.crank_angle)?;
+            one.set_item("min", e.min.value)?;
+            one.set_item("refined", e.refined)?;
+            extremes.set_item(name, one)?;
+        }
+        d.set_item("extremes", extremes)?;
         Ok(d)
     }
 

@@ -18,6 +18,7 @@ from .ltca import (
     TwistLoop,
     ltca,
     running_friction,
+    tooth_mesh_angles,
     torque_twist,
     transmission_error,
 )
@@ -30,6 +31,7 @@ __all__ = [
     "TwistLoop",
     "ltca",
     "running_friction",
+    "tooth_mesh_angles",
     "torque_twist",
     "transmission_error",
 ]

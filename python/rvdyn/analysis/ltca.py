@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Sequence
@@ -18,7 +19,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
 __all__ = ["ARCMIN", "ARCSEC", "LtcaResult", "TransmissionError", "TwistLoop", "ltca", "running_friction",
-           "torque_twist", "transmission_error"]
+           "torque_twist", "tooth_mesh_angles", "transmission_error"]
 
 #: One arc minute and one arc second [rad].
 ARCMIN: float = math.pi / (180.0 * 60.0)
@@ -170,7 +171,11 @@ class LtcaResult:
 @dataclass(frozen=True)
 class TransmissionError:
     """TE over one mesh period, forward (+torque) and reverse (-torque), loaded and at a light
-    load (unloaded) [rad]; ``crank_angle`` [rad], ``period`` [rad]."""
+    load (unloaded) [rad]; ``crank_angle`` [rad], ``period`` [rad]. ``extremes[curve]`` holds
+    each curve's largest and smallest TE located between the crank angles: ``max``, ``min``
+    [rad] at ``max_angle``, ``min_angle`` [rad]; ``refined[curve]`` is false where the
+    equilibria depend on the path (a very light load), and the extremes are then the samples'
+    (docs/model.md, "Transmission error")."""
 
     crank_angle: np.ndarray
     period: float
@@ -180,11 +185,13 @@ class TransmissionError:
     unloaded_reverse: np.ndarray
     torque: float
     light: float
+    extremes: dict[str, dict[str, float]]
+    refined: dict[str, bool]
 
     def peak_to_peak(self) -> dict[str, float]:
-        """Peak-to-peak of each curve [rad]."""
-        return {k: float(np.ptp(getattr(self, k))) for k in
-                ("forward", "reverse", "unloaded_forward", "unloaded_reverse")}
+        """Peak-to-peak of each curve [rad]: its refined largest minus smallest TE (at least
+        the samples' own peak-to-peak)."""
+        return {k: float(e["max"] - e["min"]) for k, e in self.extremes.items()}
 
     def lost_motion(self) -> np.ndarray:
         """Difference of the reverse and forward TE at each crank angle [rad] (the lost motion
@@ -311,6 +318,21 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
                       fea_json=fea_json)
 
 
+def tooth_mesh_angles(scene: Scene) -> int:
+    """Crank angles per mesh period that place two in every tooth-mesh cycle of an ISO 6336
+    mesh (whose stiffness steps between one and two tooth pairs once per base pitch, passed
+    every ``2 pi zc / (z_planet zp)`` of crank angle with the input held; docs/model.md,
+    "Transmission error"); 2 for mesh laws that do not vary along the path of contact."""
+    d = _scene(scene).to_dict()
+    stage = d.get("stage1")
+    if stage is None or d["contact"]["mesh"]["kind"] != "iso6336":
+        return 2
+    zp = int(d["cycloid"]["pins"])
+    cycle = 2.0 * math.pi * (zp - 1) / (int(stage["z_planet"]) * zp)
+    period = float(_core.LtcaSolver(_scene(scene)._compiled, 1e-12).mesh_period)
+    return max(2, math.ceil(2.0 * period / cycle - 1e-9))
+
+
 def transmission_error(scene: Scene, torque: float | None = None, points: int = 90, *,
                        light: float | None = None, start: float = 0.0) -> TransmissionError:
     """TE over one mesh period at ``points`` crank angles, at ``+-torque`` and at the light load
@@ -320,10 +342,28 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int = 
     lt = 1e-6 * t if light is None else abs(_float("light", light, "N m"))
     d = _core.LtcaSolver(sc._compiled, 1e-12).transmission_error(t, lt, int(points),
                                                                  _float("start", start, "rad"))
-    return TransmissionError(crank_angle=d["crank_angle"], period=float(d["period"]),
-                             forward=d["forward"], reverse=d["reverse"],
-                             unloaded_forward=d["unloaded_forward"],
-                             unloaded_reverse=d["unloaded_reverse"], torque=t, light=lt)
+    te = TransmissionError(crank_angle=d["crank_angle"], period=float(d["period"]),
+                           forward=d["forward"], reverse=d["reverse"],
+                           unloaded_forward=d["unloaded_forward"],
+                           unloaded_reverse=d["unloaded_reverse"], torque=t, light=lt,
+                           extremes={k: {q: float(e[q]) for q in ("max_angle", "max", "min_angle", "min")}
+                                     for k, e in d["extremes"].items()},
+                           refined={k: bool(e["refined"]) for k, e in d["extremes"].items()})
+    needed = tooth_mesh_angles(sc)
+    if int(points) < needed:
+        warnings.warn(
+            f"transmission_error: {int(points)} crank angles per mesh period are fewer than two "
+            f"per tooth-mesh cycle of the ISO 6336 mesh, so a TE peak can lie where no angle's "
+            f"neighbourhood is searched; use points >= {needed}", RuntimeWarning, stacklevel=2)
+    path_dependent = [k for k, ok in te.refined.items() if not ok]
+    if path_dependent:
+        warnings.warn(
+            f"transmission_error: the equilibria of {', '.join(path_dependent)} depend on the "
+            f"path to them (bodies floating in their clearances; light load {lt:.3g} N m), so "
+            "their peak-to-peak is the samples' (not located between them) and depends on the "
+            "sweep; a larger load (`light` for the unloaded curves) makes them unique",
+            RuntimeWarning, stacklevel=2)
+    return te
 
 
 def torque_twist(scene: Scene, rated_torque: float | None = None, crank_angle: float = 0.0,

@@ -116,8 +116,8 @@ class FunctionKernel:
 
 #: Metrics of :class:`LtcaKernel` (SI units; the conventions of docs/model.md, "Quasi-static analysis").
 LTCA_METRICS: dict[str, str] = {
-    "te_pp_forward": "transmission error peak-to-peak over one mesh period at +torque [rad]",
-    "te_pp_reverse": "transmission error peak-to-peak over one mesh period at -torque [rad]",
+    "te_pp_forward": "transmission error peak-to-peak over one mesh period at +torque, extremes located between the crank angles [rad]",
+    "te_pp_reverse": "transmission error peak-to-peak over one mesh period at -torque, extremes located between the crank angles [rad]",
     "peak_pin_force": "largest pin force over the crank angles and discs at the torque [N]",
     "loaded_pins_min": "fewest pins in contact on any disc over the crank angles [-]",
     "torsional_rigidity": "catalogue torsional rigidity of the torque-twist loop [N m/rad]",
@@ -132,8 +132,10 @@ class LtcaKernel:
     torque: output torque [N m] (None: the scene's constant load; its magnitude is used for
     the two drive directions and as the rated torque of the twist loop). points: crank angles
     over one mesh period for the transmission error and the pin loads (small by default to keep
-    a sample cheap). twist_points: points of the torque-twist loop 0 -> +T -> -T -> 0, taken
-    at crank_angle [rad]. A sample whose analysis fails (no equilibrium, invalid geometry)
+    a sample cheap; raised to two per tooth-mesh cycle of an ISO 6336 mesh,
+    :func:`rvdyn.analysis.tooth_mesh_angles`, so that the TE's extremes are found).
+    twist_points: points of the torque-twist loop 0 -> +T -> -T -> 0, taken at crank_angle
+    [rad]. A sample whose analysis fails (no equilibrium, invalid geometry)
     raises its error, which the study records in the sample's row."""
 
     torque: float | None = None
@@ -158,24 +160,25 @@ class LtcaKernel:
         return tuple(LTCA_METRICS)
 
     def __call__(self, scene: Scene) -> dict[str, float]:
-        # The computations of rvdyn.analysis.transmission_error (its loaded part), ltca and
-        # torque_twist, on one solver (built once per sample; the same metrics to ~1e-12
-        # relative): equilibria at +-torque over one mesh period, then the loop. The unloaded
+        # The computations of rvdyn.analysis.transmission_error (its loaded part, with the
+        # extremes located between the crank angles), ltca and torque_twist, on one solver
+        # (built once per sample; the same metrics to ~1e-12 relative): TE at +-torque over one
+        # mesh period, the equilibria at +torque for the pin loads, then the loop. The unloaded
         # TE is not a metric and is not computed.
         from .. import _core
-        from ..analysis.ltca import _rated, _scene
+        from ..analysis.ltca import _rated, _scene, tooth_mesh_angles
 
         sc = _scene(scene)
         torque = abs(_rated(sc, self.torque))
         solver = _core.LtcaSolver(sc._compiled, 1e-12)
-        angles = (float(solver.mesh_period) * np.arange(self.points) / self.points).tolist()
-        static = solver.sweep(torque, angles)
-        reverse = solver.sweep(-torque, angles)
-        te = {"forward": static["transmission_error"], "reverse": reverse["transmission_error"]}
+        points = max(self.points, tooth_mesh_angles(sc))
+        te = solver.transmission_error(torque, None, points, 0.0)
+        pp = {k: float(e["max"] - e["min"]) for k, e in te["extremes"].items()}
+        static = solver.sweep(torque, te["crank_angle"].tolist())
         loop = solver.twist_loop(torque, float(self.crank_angle), self.twist_points)
         return {
-            "te_pp_forward": float(np.ptp(te["forward"])),
-            "te_pp_reverse": float(np.ptp(te["reverse"])),
+            "te_pp_forward": pp["forward"],
+            "te_pp_reverse": pp["reverse"],
             "peak_pin_force": float(np.max(static["pin_force"])) if static["pin_force"].size else 0.0,
             "loaded_pins_min": float(np.min(static["loaded_pins"])),
             "torsional_rigidity": float(loop["rigidity"]),

@@ -16,6 +16,7 @@ pub mod friction;
 mod gear_errors;
 pub mod newton;
 pub mod statics;
+pub mod te_extremes;
 
 use std::f64::consts::{PI, TAU};
 
@@ -27,6 +28,7 @@ use newton::{Scratch, equilibrium, solve_dense};
 use rayon::prelude::*;
 use serde::Serialize;
 use statics::{CARRIER, Statics, Work};
+pub use te_extremes::{CurveExtremes, Extreme};
 
 /// One arc minute \[rad\].
 pub const ARCMIN: f64 = PI / (180.0 * 60.0);
@@ -117,10 +119,26 @@ pub struct TransmissionError {
     pub unloaded_forward: Vec<f64>,
     /// TE at `-light` \[rad\]: the unloaded TE, reverse.
     pub unloaded_reverse: Vec<f64>,
+    /// Each curve's extremes, located between the crank angles ([`te_extremes`]): their
+    /// difference is the curve's peak-to-peak.
+    pub extremes: TeExtremes,
     /// Loaded torque [N m].
     pub torque: f64,
-    /// Light torque of the unloaded TE [N m].
+    /// Light torque of the unloaded TE [N m] (0 without the unloaded curves).
     pub light: f64,
+}
+
+/// The extremes of the four TE curves.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TeExtremes {
+    /// At `+torque`.
+    pub forward: CurveExtremes,
+    /// At `-torque`.
+    pub reverse: CurveExtremes,
+    /// At `+light` (`None` without the unloaded curves).
+    pub unloaded_forward: Option<CurveExtremes>,
+    /// At `-light` (`None` without the unloaded curves).
+    pub unloaded_reverse: Option<CurveExtremes>,
 }
 
 /// Peak-to-peak of a series.
@@ -660,12 +678,14 @@ impl Ltca {
     }
 
     /// Transmission error over one mesh period at `points` crank angles, at `+-torque`
-    /// (loaded) and `+-light` (unloaded: a light load that keeps the flanks in contact, as in
-    /// single-flank testing) [N m].
+    /// (loaded) and, with `light`, at `+-light` (unloaded: a light load that keeps the flanks
+    /// in contact, as in single-flank testing) [N m]; without it the unloaded curves are empty
+    /// (and their extremes `None`). Each curve's extremes are located between the crank
+    /// angles ([`te_extremes`]).
     pub fn transmission_error(
         &mut self,
         torque: f64,
-        light: f64,
+        light: Option<f64>,
         points: usize,
         start: f64,
     ) -> Result<TransmissionError> {
@@ -676,42 +696,38 @@ impl Ltca {
             )));
         }
         let period = self.mesh_period;
-        let angles: Vec<f64> = (0..points)
-            .map(|i| start + period * i as f64 / points as f64)
-            .collect();
-        let run = |ltca: &mut Ltca, t: f64| -> Result<Vec<f64>> {
+        let step = period / points as f64;
+        let angles: Vec<f64> = (0..points).map(|i| start + step * i as f64).collect();
+        // One curve: the sweep, then its extremes refined between the crank angles.
+        let run = |ltca: &mut Ltca, t: Option<f64>| -> Result<(Vec<f64>, Option<CurveExtremes>)> {
+            let Some(t) = t else {
+                return Ok((Vec::new(), None));
+            };
             ltca.reset();
-            angles
+            let samples = angles
                 .iter()
-                .map(|&p| {
-                    let (out, _) = ltca.output_angle(t, p)?;
-                    let input = if ltca.statics.model.mesh.is_some() {
-                        ltca.statics.held_input(p)
-                    } else {
-                        p
-                    };
-                    Ok(out - input / ltca.ratio)
-                })
-                .collect()
+                .map(|&p| ltca.te_sample(t, p))
+                .collect::<Result<Vec<_>>>()?;
+            let extremes = ltca.refine_extremes(t, &samples, step, period)?;
+            Ok((samples.into_iter().map(|s| s.te).collect(), Some(extremes)))
         };
         // The four sweeps are independent (each starts from the kinematic pose): two chains
         // on two threads, each one loaded and one light sweep (the light ones cost several
         // times more), this analysis ending as after the light reverse sweep.
         let mut other = self.clone();
         let evaluations = self.statics.evaluations;
+        let (t, l) = (torque.abs(), light.map(f64::abs));
+        type Curve = (Vec<f64>, Option<CurveExtremes>);
         let (a, b) = rayon::join(
-            || -> Result<(Vec<f64>, Vec<f64>)> {
-                Ok((
-                    run(&mut other, torque.abs())?,
-                    run(&mut other, light.abs())?,
-                ))
-            },
-            || -> Result<(Vec<f64>, Vec<f64>)> {
-                Ok((run(self, -torque.abs())?, run(self, -light.abs())?))
-            },
+            || -> Result<(Curve, Curve)> { Ok((run(&mut other, Some(t))?, run(&mut other, l)?)) },
+            || -> Result<(Curve, Curve)> { Ok((run(self, Some(-t))?, run(self, l.map(|v| -v))?)) },
         );
         self.statics.evaluations += other.statics.evaluations - evaluations;
-        let ((forward, unloaded_forward), (reverse, unloaded_reverse)) = (a?, b?);
+        let (((forward, fe), (unloaded_forward, ufe)), ((reverse, re), (unloaded_reverse, ure))) =
+            (a?, b?);
+        let loaded = |e: Option<CurveExtremes>| {
+            e.ok_or_else(|| RvdynError::Convergence("a loaded TE curve without extremes".into()))
+        };
         Ok(TransmissionError {
             crank_angle: angles,
             period,
@@ -719,8 +735,14 @@ impl Ltca {
             reverse,
             unloaded_forward,
             unloaded_reverse,
-            torque: torque.abs(),
-            light: light.abs(),
+            extremes: TeExtremes {
+                forward: loaded(fe)?,
+                reverse: loaded(re)?,
+                unloaded_forward: ufe,
+                unloaded_reverse: ure,
+            },
+            torque: t,
+            light: l.unwrap_or(0.0),
         })
     }
 
