@@ -148,3 +148,23 @@ def test_analyze_command_writes_figures_loads_and_summary(tmp_path: Path) -> Non
                         "--angles", "6", "--loop-points", "21"], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     assert json.loads((out / "summary.json").read_text())["scene"] == "paper"
+
+
+def test_large_crank_angles_converge_or_say_why() -> None:
+    """Crank angles of many turns (a long dynamic run's, say): the round-off floor of Newton's
+    test grows with the largest unknown as a length (docs/model.md, "Newton iteration"), so the
+    physical preset converges at 6e4 rad (a ConvergenceError before, from about 1e4 rad) to
+    the equilibrium of the same crank position (TE within 3e-7 rad of it at 0.3 rad: the roller
+    sets fixed in the frame do not repeat with the mesh period, docs/model.md, "Mesh period");
+    where it still cannot (the paper preset at 6e4 rad), the error says to give the angle
+    modulo the mesh period."""
+    rated = 43_921.3
+    scene = Scene.physical("rated")
+    period = float(rvdyn._core.LtcaSolver(scene._compiled, 1e-12).mesh_period)
+    far = ltca(scene, rated, [0.3 + 10_000 * period])
+    near = ltca(scene, rated, [0.3])
+    assert far.residual[0] < 1e-8 and far.torque_balance[0] < 1e-8
+    assert abs(far.transmission_error[0] - near.transmission_error[0]) < 3e-7
+    assert far.loaded_pins.tolist() == near.loaded_pins.tolist()
+    with pytest.raises(rvdyn.ConvergenceError, match="modulo the mesh period"):
+        ltca(Scene.paper("rated"), rated, [60_000.3])

@@ -389,7 +389,14 @@ pub fn equilibrium(
     let n = st.dim();
     let rp = st.scale[0];
     let load = torque.abs() / rp;
-    let floor = 4.0 * f64::EPSILON * k_ref * rp;
+    // Positions carry round-off of about eps times their size: the pin circle radius, or a
+    // body turned by many revolutions (a crank angle of 1e4 rad puts the carrier 65 m of arc
+    // away), whose positions near the contacts lose that much.
+    let size = q
+        .iter()
+        .zip(&scratch.scale)
+        .fold(rp, |m, (x, l)| m.max((x * l).abs()));
+    let floor = 4.0 * f64::EPSILON * k_ref * size;
     let done = (opts.tolerance * load).max(floor);
     let stalled_ok = (1e-9 * load).max(10.0 * floor);
     let report_scale = load.max(1.0);
@@ -477,7 +484,7 @@ pub fn equilibrium(
                     .iter()
                     .zip(scale)
                     .fold(0.0f64, |m, (d, l)| m.max((d * l).abs()));
-                if moved <= STEP_ROUND_OFF * f64::EPSILON * rp {
+                if moved <= STEP_ROUND_OFF * f64::EPSILON * size {
                     finish!(it - 1, rmax / report_scale);
                 }
             }
@@ -611,11 +618,19 @@ pub fn equilibrium(
 }
 
 fn not_converged(psi: f64, torque: f64, residual: f64, it: usize) -> RvdynError {
+    // Beyond about 1e3 rad the round-off of whole turns in the positions can exceed the
+    // tolerance (docs/model.md, "Newton iteration").
+    let turns = if psi.abs() > 1e3 {
+        " Or the crank angle is so large that the round-off of its whole turns exceeds the \
+         tolerance: give it modulo the mesh period (the TE repeats)."
+    } else {
+        ""
+    };
     RvdynError::Convergence(format!(
         "the static equilibrium (LTCA) did not converge at crank angle {psi:.6} rad, output \
          torque {torque:.6e} N m: scaled residual {residual:.3e} of the load after {it} \
          iterations. Either the torque exceeds what the contacts can carry, or a clearance \
-         leaves a body unsupported (no equilibrium): reduce the torque or the clearances"
+         leaves a body unsupported (no equilibrium): reduce the torque or the clearances.{turns}"
     ))
 }
 
