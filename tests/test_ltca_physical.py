@@ -165,3 +165,15 @@ def test_te_extremes_are_located_between_the_crank_angles() -> None:
         assert np.max(sense * dense) <= sense * value + 1e-9 * pp
         single = ltca(scene, RATED, [angle]).transmission_error[0]
         assert single == pytest.approx(value, abs=1e-9 * pp)
+
+
+def test_default_te_grid_resolves_the_tooth_mesh_ripple() -> None:
+    """42 base pitches pass per mesh period of the physical preset (6.02 rad over 0.143 rad):
+    the default grid puts eight angles in each (336), the paper's IMPACT mesh keeps 90."""
+    scene = Scene.physical("rated")
+    period = transmission_error(scene, RATED, 84).period
+    cycle = 2.0 * math.pi * 23 / (42 * 24)
+    assert period / cycle == pytest.approx(42.0, abs=1e-9)
+    assert rvdyn.analysis.tooth_mesh_angles(scene) == 84
+    assert transmission_error(scene, RATED).crank_angle.size == 336
+    assert transmission_error(Scene.paper("rated"), RATED).crank_angle.size == 90

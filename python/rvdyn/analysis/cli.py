@@ -20,8 +20,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "6336 meshes, roller bearings; paper: the paper's IMPACT laws, rigid joints)")
     p.add_argument("--torque", type=float, default=None, metavar="NM",
                    help="output torque [N m] (default: the scene's constant load)")
-    p.add_argument("--angles", type=int, default=90, metavar="N",
-                   help="crank angles per mesh period (default 90)")
+    p.add_argument("--angles", type=int, default=None, metavar="N",
+                   help="crank angles per mesh period (default 90 for the load distribution; "
+                        "for the TE, eight per tooth-mesh cycle of an ISO mesh, at least 90)")
     p.add_argument("--loop-points", type=int, default=201, metavar="N",
                    help="points of the torque-twist loop (default 201)")
     p.add_argument("--out", default="rvdyn-out", metavar="DIR", help="output folder (default rvdyn-out)")
@@ -49,8 +50,9 @@ def run(args: argparse.Namespace) -> int:
     print(f"rvdyn analyze: scene {scene['name'] or '(unnamed)'}, writing to {out}/", file=sys.stderr)
     probe = ltca(scene, args.torque, [0.0])
     period = probe.mesh_period
-    angles = period * np.arange(args.angles) / args.angles
-    res = ltca(scene, args.torque, angles, progress=_progress, chunk=max(args.angles // 10, 1))
+    n = 90 if args.angles is None else args.angles
+    angles = period * np.arange(n) / n
+    res = ltca(scene, args.torque, angles, progress=_progress, chunk=max(n // 10, 1))
     print("  TE both directions ...", file=sys.stderr)
     te = transmission_error(scene, args.torque, args.angles)
     print("  torque-twist loop ...", file=sys.stderr)

@@ -200,7 +200,8 @@ class TransmissionError:
         return diff
 
     def plot(self, ax: Axes | None = None) -> Figure:
-        """TE in arcsec about its mean, both directions, loaded and unloaded."""
+        """TE in arcsec about its mean, both directions, loaded and unloaded, with each curve's
+        extremes (dots)."""
         from ..plotting import new_figure
 
         fig, ax = new_figure((8.0, 4.5)) if ax is None else (ax.figure, ax)
@@ -208,8 +209,13 @@ class TransmissionError:
         for name, style in (("forward", "-"), ("reverse", "-"), ("unloaded_forward", "--"),
                             ("unloaded_reverse", "--")):
             y = getattr(self, name)
-            ax.plot(x, (y - y.mean()) / ARCSEC, style,
-                    label=f"{name.replace('_', ' ')} (mean {y.mean() / ARCMIN:+.2f} arcmin)")
+            (line,) = ax.plot(x, (y - y.mean()) / ARCSEC, style,
+                              label=f"{name.replace('_', ' ')} (mean {y.mean() / ARCMIN:+.2f} arcmin)")
+            # The extremes located between the crank angles (the peak-to-peak's ends).
+            e = self.extremes[name]
+            ax.plot(np.degrees([e["max_angle"], e["min_angle"]]),
+                    (np.array([e["max"], e["min"]]) - y.mean()) / ARCSEC, "o",
+                    color=line.get_color(), markersize=3)
         ax.set_xlabel("crank angle [deg] (one mesh period)")
         ax.set_ylabel("TE about its mean [arcsec]")
         ax.set_title(f"transmission error, T = +-{self.torque / 1e3:.2f} kN m")
@@ -333,11 +339,16 @@ def tooth_mesh_angles(scene: Scene) -> int:
     return max(2, math.ceil(2.0 * period / cycle - 1e-9))
 
 
-def transmission_error(scene: Scene, torque: float | None = None, points: int = 90, *,
+def transmission_error(scene: Scene, torque: float | None = None, points: int | None = None, *,
                        light: float | None = None, start: float = 0.0) -> TransmissionError:
     """TE over one mesh period at ``points`` crank angles, at ``+-torque`` and at the light load
-    ``+-light`` [N m] (default ``1e-6 torque``) from crank angle ``start`` [rad]."""
+    ``+-light`` [N m] (default ``1e-6 torque``) from crank angle ``start`` [rad]. By default
+    ``points`` is 90, or eight per tooth-mesh cycle of an ISO 6336 mesh if that is more
+    (``4 tooth_mesh_angles(scene)``: 336 on the physical preset, whose TE ripples 42 times per
+    period). Each curve's extremes are located between the crank angles (``extremes``)."""
     sc = _scene(scene)
+    if points is None:
+        points = max(90, 4 * tooth_mesh_angles(sc))
     t = abs(_rated(sc, torque))
     lt = 1e-6 * t if light is None else abs(_float("light", light, "N m"))
     d = _core.LtcaSolver(sc._compiled, 1e-12).transmission_error(t, lt, int(points),
