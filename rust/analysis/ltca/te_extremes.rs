@@ -86,10 +86,10 @@ impl Ltca {
     /// `CANDIDATES` sampled local extremes that could pass the best sample are searched on
     /// nested grids, each level `2 SUBDIVISIONS - 1` crank angles at `1 / SUBDIVISIONS` of the
     /// last step from one step before the best to one step after it, continued in the sweep's
-    /// direction from the solution one step before, down to the step `STOP` times `period`. Never worse than the samples (they are among the
-    /// points). Where a crank angle solved again along this path gives another equilibrium
-    /// (bodies floating in their clearances at a very light load), the sampled extremes are
-    /// returned, with `refined` false.
+    /// direction from the solution one step before, down to the step `STOP` times `period`.
+    /// Never worse than the samples (they are among the points). Where a crank angle solved
+    /// again along this path gives another equilibrium (bodies floating in their clearances at
+    /// a very light load), the sampled extremes are returned, with `refined` false.
     pub(super) fn refine_extremes(
         &mut self,
         torque: f64,
@@ -97,6 +97,11 @@ impl Ltca {
         step: f64,
         period: f64,
     ) -> Result<CurveExtremes> {
+        let Some(first) = samples.first() else {
+            return Err(crate::error::RvdynError::Parameter(
+                "transmission error extremes need at least one crank angle".into(),
+            ));
+        };
         let max = self.refine_sense(torque, samples, step, period, 1.0)?;
         let min = match max {
             Some(_) => self.refine_sense(torque, samples, step, period, -1.0)?,
@@ -114,7 +119,7 @@ impl Ltca {
                     let s = samples
                         .iter()
                         .max_by(|x, y| (sense * x.te).total_cmp(&(sense * y.te)))
-                        .unwrap_or(&samples[0]);
+                        .unwrap_or(first);
                     Extreme {
                         crank_angle: s.psi,
                         value: s.te,
@@ -160,9 +165,12 @@ impl Ltca {
                 (a.min(s.te), b.max(s.te))
             });
         let same = SAME_PATH * (hi - lo) + SAME_FLOOR;
+        let Some(&first) = candidates.first() else {
+            return Ok(None);
+        };
         let mut best = Extreme {
-            crank_angle: samples[candidates[0]].psi,
-            value: samples[candidates[0]].te,
+            crank_angle: samples[first].psi,
+            value: samples[first].te,
         };
         for &i in &candidates {
             // Continued from the sample before, in the sweep's direction; the first sample's
