@@ -143,6 +143,12 @@ def test_analyze_command_writes_figures_loads_and_summary(tmp_path: Path) -> Non
     summary = json.loads((out / "summary.json").read_text())
     assert summary["rigidity_Nm_per_arcmin"] > 0 and summary["scene"] == "physical"
     assert "LTCA: 12/12" in r.stderr
+    # The TE figures are transmission_error's located extremes only (not also the samples'
+    # peak-to-peak of the load sweep), and 12 angles are too few for the ISO tooth-mesh cycle.
+    assert not any(k.startswith("te_peak_to_peak") and k != "te_peak_to_peak_arcsec" for k in summary)
+    assert set(summary["te_peak_to_peak_arcsec"]) == {"forward", "reverse", "unloaded_forward",
+                                                      "unloaded_reverse"}
+    assert "use points >= 84" in r.stderr
     # The paper preset by flag.
     r = subprocess.run([sys.executable, "-m", "rvdyn", "analyze", "--preset", "paper", "--out", str(out),
                         "--angles", "6", "--loop-points", "21"], capture_output=True, text=True, timeout=300)

@@ -88,8 +88,9 @@ class LtcaResult:
         return float(np.max(self.arrays["pin_force"])) if self.arrays["pin_force"].size else 0.0
 
     def summary(self) -> dict[str, Any]:
-        """Peak pin force [N], loaded pins per disc (min, max), TE peak-to-peak [rad], worst
-        torque balance and residual."""
+        """Peak pin force [N], loaded pins per disc (min, max), the peak-to-peak of the TE at
+        these crank angles [rad] (of the samples: ``transmission_error`` locates the extremes
+        between them), worst torque balance and residual."""
         a = self.arrays
         return {
             "torque_Nm": self.torque,
@@ -97,7 +98,7 @@ class LtcaResult:
             "peak_pin_force_N": self.peak_pin_force,
             "loaded_pins_min": int(a["loaded_pins"].min()),
             "loaded_pins_max": int(a["loaded_pins"].max()),
-            "te_peak_to_peak_rad": float(np.ptp(a["transmission_error"])),
+            "te_peak_to_peak_samples_rad": float(np.ptp(a["transmission_error"])),
             "torque_balance_max": float(a["torque_balance"].max()),
             "residual_max": float(a["residual"].max()),
             "peak_pressure_max_Pa": float(a["peak_pressure"].max()),
