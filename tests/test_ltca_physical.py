@@ -177,3 +177,21 @@ def test_default_te_grid_resolves_the_tooth_mesh_ripple() -> None:
     assert rvdyn.analysis.tooth_mesh_angles(scene) == 84
     assert transmission_error(scene, RATED).crank_angle.size == 336
     assert transmission_error(Scene.paper("rated"), RATED).crank_angle.size == 90
+
+
+def test_te_window_with_roller_sets_is_twelve_mesh_periods() -> None:
+    """The roller sets stay fixed in the frame, so the whole static state repeats only when
+    the carrier has turned the assembly onto every roller set (docs/model.md, "Mesh period"):
+    on the physical preset lcm(23/24, 23/20, 23/26) = 23/2 turns, twelve mesh periods. The TE
+    at 0.3 rad plus the window equals that at 0.3 rad (measured below 1e-15 rad), plus one
+    mesh period it does not (measured 8.2e-8 rad, the roller-pass ripple); the paper preset
+    (rigid joints) repeats over its mesh period."""
+    scene = Scene.physical("rated")
+    te = transmission_error(scene, RATED, 84)
+    assert te.window == pytest.approx(12 * te.period, rel=1e-12)
+    assert te.window == pytest.approx(23 * math.pi, rel=1e-12)
+    at = ltca(scene, RATED, [0.3, 0.3 + te.period, 0.3 + te.window]).transmission_error
+    assert abs(at[2] - at[0]) < 1e-12
+    assert abs(at[1] - at[0]) > 1e-8
+    paper = transmission_error(Scene.paper("rated"), RATED, 24)
+    assert paper.window == paper.period

@@ -475,6 +475,11 @@ class LtcaSolver:
     def mesh_period(self) -> float:
         """Crank-angle period of the contact pattern [rad]."""
     @property
+    def te_window(self) -> float:
+        """Crank-angle window after which the whole static state repeats [rad]: the mesh
+        period, or a multiple of it with roller bearings (their roller sets stay fixed in the
+        frame)."""
+    @property
     def ratio(self) -> float:
         """Transmission ratio input/output."""
     @property

@@ -53,6 +53,14 @@ impl LtcaSolver {
         Ok(self.lock()?.mesh_period())
     }
 
+    /// The crank-angle window after which the whole static state repeats [rad]: the mesh
+    /// period, or a multiple of it with roller bearings (their roller sets stay fixed in the
+    /// frame).
+    #[getter]
+    fn te_window(&self) -> PyResult<f64> {
+        Ok(self.lock()?.te_window())
+    }
+
     /// Transmission ratio input/output.
     #[getter]
     fn ratio(&self) -> PyResult<f64> {

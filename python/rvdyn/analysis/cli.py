@@ -73,6 +73,7 @@ def run(args: argparse.Namespace) -> int:
         # the load-distribution sweep's samples.
         **{k: v for k, v in res.summary().items() if not k.startswith("te_")},
         "te_peak_to_peak_arcsec": {k: v / ARCSEC for k, v in pp.items()},
+        "te_window_rad": te.window,
         "te_mean_arcmin": {"forward": float(te.forward.mean()) / ARCMIN,
                            "reverse": float(te.reverse.mean()) / ARCMIN},
         **loop.summary(),
@@ -88,7 +89,11 @@ def run(args: argparse.Namespace) -> int:
         f"{summary['peak_pressure_max_Pa'] / 1e6:.0f} MPa",
         f"- TE peak-to-peak: forward {pp['forward'] / ARCSEC:.3f} arcsec, reverse "
         f"{pp['reverse'] / ARCSEC:.3f} arcsec (unloaded {pp['unloaded_forward'] / ARCSEC:.3f} / "
-        f"{pp['unloaded_reverse'] / ARCSEC:.3f} arcsec)",
+        f"{pp['unloaded_reverse'] / ARCSEC:.3f} arcsec)" + (
+            "" if te.window <= 1.000001 * te.period else
+            f" over one mesh period; with the roller sets fixed in the frame the TE repeats only "
+            f"after {te.window:.2f} rad ({te.window / te.period:.0f} periods) and differs from "
+            f"period to period by their roller-pass ripple"),
         f"- torsional rigidity {summary['rigidity_Nm_per_arcmin']:.1f} N m/arcmin, lost motion "
         f"{summary['lost_motion_arcmin']:.3f} arcmin, backlash {summary['backlash_arcmin']:.3f} arcmin",
         f"- equilibrium: torque balance <= {summary['torque_balance_max']:.1e}, residual <= "

@@ -176,7 +176,10 @@ class TransmissionError:
     each curve's largest and smallest TE located between the crank angles: ``max``, ``min``
     [rad] at ``max_angle``, ``min_angle`` [rad]; ``refined[curve]`` is false where the
     equilibria depend on the path (a very light load), and the extremes are then the samples'
-    (docs/model.md, "Transmission error")."""
+    (docs/model.md, "Transmission error"). ``window`` [rad] is the crank angle after which
+    the whole TE repeats: ``period``, or with roller bearings (whose roller sets stay fixed in
+    the frame) a multiple of it, over which the TE differs from period to period by the
+    roller-pass ripple (docs/model.md, "Mesh period")."""
 
     crank_angle: np.ndarray
     period: float
@@ -188,6 +191,7 @@ class TransmissionError:
     light: float
     extremes: dict[str, dict[str, float]]
     refined: dict[str, bool]
+    window: float
 
     def peak_to_peak(self) -> dict[str, float]:
         """Peak-to-peak of each curve [rad]: its refined largest minus smallest TE (at least
@@ -352,15 +356,16 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
         points = max(90, 4 * tooth_mesh_angles(sc))
     t = abs(_rated(sc, torque))
     lt = 1e-6 * t if light is None else abs(_float("light", light, "N m"))
-    d = _core.LtcaSolver(sc._compiled, 1e-12).transmission_error(t, lt, int(points),
-                                                                 _float("start", start, "rad"))
+    solver = _core.LtcaSolver(sc._compiled, 1e-12)
+    d = solver.transmission_error(t, lt, int(points), _float("start", start, "rad"))
     te = TransmissionError(crank_angle=d["crank_angle"], period=float(d["period"]),
                            forward=d["forward"], reverse=d["reverse"],
                            unloaded_forward=d["unloaded_forward"],
                            unloaded_reverse=d["unloaded_reverse"], torque=t, light=lt,
                            extremes={k: {q: float(e[q]) for q in ("max_angle", "max", "min_angle", "min")}
                                      for k, e in d["extremes"].items()},
-                           refined={k: bool(e["refined"]) for k, e in d["extremes"].items()})
+                           refined={k: bool(e["refined"]) for k, e in d["extremes"].items()},
+                           window=float(solver.te_window))
     needed = tooth_mesh_angles(sc)
     if int(points) < needed:
         warnings.warn(

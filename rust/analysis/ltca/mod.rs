@@ -309,6 +309,7 @@ pub struct Ltca {
     face_width: f64,
     ratio: f64,
     mesh_period: f64,
+    te_window: f64,
     /// The scene's friction (as the dynamic models apply it; `friction`).
     friction: friction::FrictionLaws,
 }
@@ -340,6 +341,7 @@ impl Ltca {
             face_width: scene.cycloid.face_width,
             ratio: scene.ratio(),
             mesh_period: mesh_period(scene),
+            te_window: te_window(scene),
             friction: friction::FrictionLaws::new(scene),
             statics,
         })
@@ -348,6 +350,12 @@ impl Ltca {
     /// Period of the mesh in crank angle \[rad\] (see [`mesh_period`]).
     pub fn mesh_period(&self) -> f64 {
         self.mesh_period
+    }
+
+    /// The crank-angle window after which the whole static state repeats \[rad\] (see
+    /// [`te_window`]): the mesh period, or a multiple of it with roller bearings.
+    pub fn te_window(&self) -> f64 {
+        self.te_window
     }
 
     /// Transmission ratio input/output.
@@ -918,6 +926,16 @@ impl Ltca {
 /// sun relative to the carrier (`z_sun zc` units) or of a planet (`z_planet zc` units): the
 /// window is then the least common multiple with those too.
 pub fn mesh_period(scene: &Scene) -> f64 {
+    // (The two forms round as the period always has.)
+    match mesh_period_turns(scene) {
+        (n, d, true) => TAU / d as f64 * n as f64,
+        (n, d, false) => TAU * n as f64 / d as f64,
+    }
+}
+
+/// [`mesh_period`] as a fraction `(numerator, denominator)` of a turn, and whether it is
+/// counted in units of `2 pi / (z_planet zp)`.
+fn mesh_period_turns(scene: &Scene) -> (u64, u64, bool) {
     let e = &scene.pin_errors;
     let errors =
         e.position.iter().any(|p| p[0] != 0.0 || p[1] != 0.0) || e.radius.iter().any(|r| *r != 0.0);
@@ -937,7 +955,7 @@ pub fn mesh_period(scene: &Scene) -> f64 {
         (false, true) => zp - 1,
         (true, true) => zp * (zp - 1),
     };
-    let pins = TAU * pitches as f64 / zp as f64;
+    let pins = (pitches, zp, false);
     let iso = matches!(
         scene.contact.mesh,
         crate::dynamics::scene::ContactLawSpec::Iso6336 { .. }
@@ -947,20 +965,50 @@ pub fn mesh_period(scene: &Scene) -> f64 {
     match (&scene.stage1, iso || gear_units > 1) {
         (Some(st), true) => {
             let zpl = u64::from(st.z_planet);
-            let unit = TAU / (zpl * zp) as f64;
             let pin_units = zpl * pitches;
             let mesh_units = gear_errors::lcm(if iso { zp - 1 } else { 1 }, gear_units);
-            let gcd = |mut a: u64, mut b: u64| {
-                while b != 0 {
-                    (a, b) = (b, a % b);
-                }
-                a
-            };
-            let lcm = pin_units / gcd(pin_units, mesh_units) * mesh_units;
-            unit * lcm as f64
+            // Units of `2 pi / (z_planet zp)`.
+            (gear_errors::lcm(pin_units, mesh_units), zpl * zp, true)
         }
         _ => pins,
     }
+}
+
+/// The crank-angle window \[rad\] after which the whole static state repeats: the
+/// [`mesh_period`], extended by the roller sets of roller bearings. The static models keep
+/// each roller set fixed in the frame (cage angle 0), so the reducer at `psi + w` must be the
+/// one at `psi` turned about the axis (with the carrier, by `w / zc`) by a multiple of
+/// `2 pi / Z` for every set of `Z` rollers: `w` a multiple of `2 pi zc / Z`. The window is the
+/// least common multiple of the mesh period and these, as fractions of a turn
+/// (`lcm(a/b, c/d) = lcm(a, c) / gcd(b, d)` in lowest terms). Physical preset: 23/24, 23/20
+/// and 23/26 of a turn give 23/2, 72.26 rad, twelve mesh periods; [`Ltca::transmission_error`]
+/// covers one mesh period (docs/model.md, "Mesh period").
+pub fn te_window(scene: &Scene) -> f64 {
+    let (n, d, _) = mesh_period_turns(scene);
+    let mut w = reduced((n, d));
+    if let crate::dynamics::scene::Joints::Compliant {
+        eccentric_bearing,
+        crank_bearing,
+    } = &scene.joints
+    {
+        let zc = u64::from(scene.cycloid.pins) - 1;
+        for b in std::iter::once(eccentric_bearing).chain(crank_bearing.as_ref()) {
+            if let Some(r) = &b.rollers {
+                let (e, f) = reduced((zc, u64::from(r.count)));
+                w = reduced((gear_errors::lcm(w.0, e), gear_errors::gcd(w.1, f)));
+            }
+        }
+    }
+    if w == reduced((n, d)) {
+        return mesh_period(scene);
+    }
+    TAU * w.0 as f64 / w.1 as f64
+}
+
+/// The fraction `n / d` in lowest terms.
+fn reduced((n, d): (u64, u64)) -> (u64, u64) {
+    let g = gear_errors::gcd(n, d).max(1);
+    (n / g, d / g)
 }
 
 #[cfg(test)]

@@ -1050,3 +1050,27 @@ fn te_extremes_are_refined_between_the_samples_and_checked_along_the_path() {
     assert!(!moved.refined);
     assert_eq!(moved.max.value, samples[top].te);
 }
+
+/// The window after which the whole static state repeats: the mesh period without roller
+/// bearings; with the physical preset's fixed roller sets (26 and 20 rollers, 23 lobes)
+/// `lcm(23/24, 23/26, 23/20)` = 23/2 turns, twelve mesh periods; one set of 23 rollers
+/// (`23/23` = 1 turn) gives `lcm(23/24, 1)` = 23 turns.
+#[test]
+fn te_window_is_the_mesh_period_extended_by_the_roller_sets() {
+    let paper = Scene::paper("rated").unwrap();
+    assert_eq!(te_window(&paper), mesh_period(&paper));
+    let mut s = Scene::physical("rated").unwrap();
+    assert!((te_window(&s) - 23.0 * PI).abs() < 1e-12);
+    assert!((te_window(&s) / mesh_period(&s) - 12.0).abs() < 1e-12);
+    if let Joints::Compliant {
+        eccentric_bearing,
+        crank_bearing,
+    } = &mut s.joints
+    {
+        if let Some(r) = eccentric_bearing.rollers.as_mut() {
+            r.count = 23;
+        }
+        *crank_bearing = None;
+    }
+    assert!((te_window(&s) - 23.0 * TAU).abs() < 1e-10);
+}
