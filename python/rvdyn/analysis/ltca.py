@@ -334,13 +334,18 @@ def tooth_mesh_angles(scene: Scene) -> int:
     mesh (whose stiffness steps between one and two tooth pairs once per base pitch, passed
     every ``2 pi zc / (z_planet zp)`` of crank angle with the input held; docs/model.md,
     "Transmission error"); 2 for mesh laws that do not vary along the path of contact."""
-    d = _scene(scene).to_dict()
+    sc = _scene(scene)
+    return _tooth_mesh_angles(sc, float(_core.LtcaSolver(sc._compiled, 1e-12).mesh_period))
+
+
+def _tooth_mesh_angles(sc: Scene, period: float) -> int:
+    """:func:`tooth_mesh_angles` of a checked scene with its mesh period [rad] known."""
+    d = sc.to_dict()
     stage = d.get("stage1")
     if stage is None or d["contact"]["mesh"]["kind"] != "iso6336":
         return 2
     zp = int(d["cycloid"]["pins"])
     cycle = 2.0 * math.pi * (zp - 1) / (int(stage["z_planet"]) * zp)
-    period = float(_core.LtcaSolver(_scene(scene)._compiled, 1e-12).mesh_period)
     return max(2, math.ceil(2.0 * period / cycle - 1e-9))
 
 
@@ -352,11 +357,12 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
     (``4 tooth_mesh_angles(scene)``: 336 on the physical preset, whose TE ripples 42 times per
     period). Each curve's extremes are located between the crank angles (``extremes``)."""
     sc = _scene(scene)
+    solver = _core.LtcaSolver(sc._compiled, 1e-12)
+    needed = _tooth_mesh_angles(sc, float(solver.mesh_period))
     if points is None:
-        points = max(90, 4 * tooth_mesh_angles(sc))
+        points = max(90, 4 * needed)
     t = abs(_rated(sc, torque))
     lt = 1e-6 * t if light is None else abs(_float("light", light, "N m"))
-    solver = _core.LtcaSolver(sc._compiled, 1e-12)
     d = solver.transmission_error(t, lt, int(points), _float("start", start, "rad"))
     te = TransmissionError(crank_angle=d["crank_angle"], period=float(d["period"]),
                            forward=d["forward"], reverse=d["reverse"],
@@ -366,7 +372,6 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
                                      for k, e in d["extremes"].items()},
                            refined={k: bool(e["refined"]) for k, e in d["extremes"].items()},
                            window=float(solver.te_window))
-    needed = tooth_mesh_angles(sc)
     if int(points) < needed:
         warnings.warn(
             f"transmission_error: {int(points)} crank angles per mesh period are fewer than two "

@@ -166,12 +166,12 @@ class LtcaKernel:
         # mesh period, the equilibria at +torque for the pin loads, then the loop. The unloaded
         # TE is not a metric and is not computed.
         from .. import _core
-        from ..analysis.ltca import _rated, _scene, tooth_mesh_angles
+        from ..analysis.ltca import _rated, _scene, _tooth_mesh_angles
 
         sc = _scene(scene)
         torque = abs(_rated(sc, self.torque))
         solver = _core.LtcaSolver(sc._compiled, 1e-12)
-        points = max(self.points, tooth_mesh_angles(sc))
+        points = max(self.points, _tooth_mesh_angles(sc, float(solver.mesh_period)))
         te = solver.transmission_error(torque, None, points, 0.0)
         pp = {k: float(e["max"] - e["min"]) for k, e in te["extremes"].items()}
         static = solver.sweep(torque, te["crank_angle"].tolist())
