@@ -95,7 +95,9 @@ impl LtcaSolver {
     }
 
     /// TE over one mesh period at `points` crank angles from `start` [rad], at +-`torque` and
-    /// (unless `light` is None) +-`light` [N m], with each curve's extremes.
+    /// (unless `light` is None) +-`light` [N m], with each curve's extremes; with
+    /// `pin_loads`, each loaded curve's peak pin force [N] and fewest loaded pins per angle.
+    #[pyo3(signature = (torque, light, points, start, pin_loads = false))]
     fn transmission_error<'py>(
         &mut self,
         py: Python<'py>,
@@ -103,9 +105,10 @@ impl LtcaSolver {
         light: Option<f64>,
         points: usize,
         start: f64,
+        pin_loads: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
-        let te = py.detach(|| ltca.transmission_error(torque, light, points, start))?;
+        let te = py.detach(|| ltca.transmission_error(torque, light, points, start, pin_loads))?;
         let d = PyDict::new(py);
         let n = te.crank_angle.len();
         d.set_item("crank_angle", f64_array(py, te.crank_angle, vec![n])?)?;
@@ -140,6 +143,17 @@ impl LtcaSolver {
             extremes.set_item(name, one)?;
         }
         d.set_item("extremes", extremes)?;
+        if let Some(loads) = te.pin_loads {
+            let pins = PyDict::new(py);
+            for (name, c) in [("forward", loads.forward), ("reverse", loads.reverse)] {
+                let one = PyDict::new(py);
+                one.set_item("peak_force", f64_array(py, c.peak_force, vec![n])?)?;
+                let fewest: Vec<i64> = c.loaded_pins_min.iter().map(|&k| k as i64).collect();
+                one.set_item("loaded_pins_min", fewest.into_pyarray(py))?;
+                pins.set_item(name, one)?;
+            }
+            d.set_item("pin_loads", pins)?;
+        }
         Ok(d)
     }
 

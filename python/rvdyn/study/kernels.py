@@ -163,7 +163,7 @@ class LtcaKernel:
         # The computations of rvdyn.analysis.transmission_error (its loaded part, with the
         # extremes located between the crank angles), ltca and torque_twist, on one solver
         # (built once per sample; the same metrics to ~1e-12 relative): TE at +-torque over one
-        # mesh period, the equilibria at +torque for the pin loads, then the loop. The unloaded
+        # mesh period with the pin loads of its +torque equilibria, then the loop. The unloaded
         # TE is not a metric and is not computed.
         from .. import _core
         from ..analysis.ltca import _rated, _scene, _tooth_mesh_angles
@@ -172,15 +172,15 @@ class LtcaKernel:
         torque = abs(_rated(sc, self.torque))
         solver = _core.LtcaSolver(sc._compiled, 1e-12)
         points = max(self.points, _tooth_mesh_angles(sc, float(solver.mesh_period)))
-        te = solver.transmission_error(torque, None, points, 0.0)
+        te = solver.transmission_error(torque, None, points, 0.0, True)
         pp = {k: float(e["max"] - e["min"]) for k, e in te["extremes"].items()}
-        static = solver.sweep(torque, te["crank_angle"].tolist())
+        pins = te["pin_loads"]["forward"]
         loop = solver.twist_loop(torque, float(self.crank_angle), self.twist_points)
         return {
             "te_pp_forward": pp["forward"],
             "te_pp_reverse": pp["reverse"],
-            "peak_pin_force": float(np.max(static["pin_force"])) if static["pin_force"].size else 0.0,
-            "loaded_pins_min": float(np.min(static["loaded_pins"])),
+            "peak_pin_force": float(np.max(pins["peak_force"])),
+            "loaded_pins_min": float(np.min(pins["loaded_pins_min"])),
             "torsional_rigidity": float(loop["rigidity"]),
             "lost_motion": float(loop["lost_motion"]),
         }

@@ -126,6 +126,27 @@ pub struct TransmissionError {
     pub torque: f64,
     /// Light torque of the unloaded TE [N m] (0 without the unloaded curves).
     pub light: f64,
+    /// Pin loads at the crank angles of the loaded curves (with `pin_loads`; else `None`).
+    pub pin_loads: Option<TePinLoads>,
+}
+
+/// Pin loads along the two loaded TE curves, read off the equilibria the TE is computed from
+/// (the same as [`Ltca::sweep`]'s reports at these crank angles, to Newton's tolerance).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TePinLoads {
+    /// At `+torque`.
+    pub forward: CurvePinLoads,
+    /// At `-torque`.
+    pub reverse: CurvePinLoads,
+}
+
+/// Pin loads of one curve, per crank angle.
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct CurvePinLoads {
+    /// Largest pin force over both discs \[N\] ([`LtcaPoint::peak_pin_force`]).
+    pub peak_force: Vec<f64>,
+    /// Fewest loaded pins (force above zero) on any disc ([`LtcaPoint::loaded_pins`]).
+    pub loaded_pins_min: Vec<usize>,
 }
 
 /// The extremes of the four TE curves.
@@ -690,12 +711,16 @@ impl Ltca {
     /// in contact, as in single-flank testing) [N m]; without it the unloaded curves are empty
     /// (and their extremes `None`). Each curve's extremes are located between the crank
     /// angles ([`te_extremes`]).
+    ///
+    /// With `pin_loads`, the peak pin force and the fewest loaded pins of each loaded curve's
+    /// equilibria are kept too ([`TePinLoads`]), which saves a [`Ltca::sweep`] at `+-torque`.
     pub fn transmission_error(
         &mut self,
         torque: f64,
         light: Option<f64>,
         points: usize,
         start: f64,
+        pin_loads: bool,
     ) -> Result<TransmissionError> {
         require_finite("start", start)?;
         if points < 2 {
@@ -707,17 +732,36 @@ impl Ltca {
         let step = period / points as f64;
         let angles: Vec<f64> = (0..points).map(|i| start + step * i as f64).collect();
         // One curve: the sweep, then its extremes refined between the crank angles.
-        let run = |ltca: &mut Ltca, t: Option<f64>| -> Result<(Vec<f64>, Option<CurveExtremes>)> {
+        type Curve = (Vec<f64>, Option<CurveExtremes>, CurvePinLoads);
+        let run = |ltca: &mut Ltca, t: Option<f64>, pins: bool| -> Result<Curve> {
             let Some(t) = t else {
-                return Ok((Vec::new(), None));
+                return Ok((Vec::new(), None, CurvePinLoads::default()));
             };
             ltca.reset();
+            let mut loads = CurvePinLoads::default();
+            // Newton's last evaluation at each solution keeps its contact state (as for a
+            // report): the pin forces at the equilibrium.
+            ltca.capture = pins;
             let samples = angles
                 .iter()
-                .map(|&p| ltca.te_sample(t, p))
-                .collect::<Result<Vec<_>>>()?;
+                .map(|&p| {
+                    let s = ltca.te_sample(t, p)?;
+                    if pins {
+                        let (peak, fewest) = ltca.captured_pin_summary();
+                        loads.peak_force.push(peak);
+                        loads.loaded_pins_min.push(fewest);
+                    }
+                    Ok(s)
+                })
+                .collect::<Result<Vec<_>>>();
+            ltca.capture = false;
+            let samples = samples?;
             let extremes = ltca.refine_extremes(t, &samples, step, period)?;
-            Ok((samples.into_iter().map(|s| s.te).collect(), Some(extremes)))
+            Ok((
+                samples.into_iter().map(|s| s.te).collect(),
+                Some(extremes),
+                loads,
+            ))
         };
         // The four sweeps are independent (each starts from the kinematic pose): two chains
         // on two threads, each one loaded and one light sweep (the light ones cost several
@@ -725,14 +769,20 @@ impl Ltca {
         let mut other = self.clone();
         let evaluations = self.statics.evaluations;
         let (t, l) = (torque.abs(), light.map(f64::abs));
-        type Curve = (Vec<f64>, Option<CurveExtremes>);
+        let p = pin_loads;
         let (a, b) = rayon::join(
-            || -> Result<(Curve, Curve)> { Ok((run(&mut other, Some(t))?, run(&mut other, l)?)) },
-            || -> Result<(Curve, Curve)> { Ok((run(self, Some(-t))?, run(self, l.map(|v| -v))?)) },
+            || -> Result<(Curve, Curve)> {
+                Ok((run(&mut other, Some(t), p)?, run(&mut other, l, false)?))
+            },
+            || -> Result<(Curve, Curve)> {
+                Ok((run(self, Some(-t), p)?, run(self, l.map(|v| -v), false)?))
+            },
         );
         self.statics.evaluations += other.statics.evaluations - evaluations;
-        let (((forward, fe), (unloaded_forward, ufe)), ((reverse, re), (unloaded_reverse, ure))) =
-            (a?, b?);
+        let (
+            ((forward, fe, fp), (unloaded_forward, ufe, _)),
+            ((reverse, re, rp), (unloaded_reverse, ure, _)),
+        ) = (a?, b?);
         let loaded = |e: Option<CurveExtremes>| {
             e.ok_or_else(|| RvdynError::Convergence("a loaded TE curve without extremes".into()))
         };
@@ -751,7 +801,25 @@ impl Ltca {
             },
             torque: t,
             light: l.unwrap_or(0.0),
+            pin_loads: pin_loads.then_some(TePinLoads {
+                forward: fp,
+                reverse: rp,
+            }),
         })
+    }
+
+    /// Largest pin force \[N\] and fewest loaded pins on any disc in the contact state
+    /// Newton captured at its last solution.
+    fn captured_pin_summary(&self) -> (f64, usize) {
+        let force = &self.scratch.state.pin_force;
+        let zp = self.statics.model.pins.len();
+        let peak = force.iter().fold(0.0f64, |m, f| m.max(*f));
+        let fewest = force
+            .chunks(zp.max(1))
+            .map(|disc| disc.iter().filter(|f| **f > 0.0).count())
+            .min()
+            .unwrap_or(0);
+        (peak, fewest)
     }
 
     /// The equilibrium at a torque `t` near zero (`|t|` far below `rated`): directly, or if
