@@ -104,6 +104,10 @@ def test_zero_load_zero_te_and_reversed_torque_mirrors() -> None:
     assert pp["forward"] == pytest.approx(pp["reverse"], rel=1e-6)
     assert np.all(te.lost_motion() > 0)
     assert te.plot().axes
+    # The repr gives the figures (arcsec), not the arrays.
+    text = repr(te)
+    assert "array" not in text and len(text) < 300
+    assert f"forward {pp['forward'] / ARCSEC:.4g}" in text and "points=24" in text
 
 
 def test_torque_twist_loop_units_and_conventions() -> None:
@@ -118,6 +122,9 @@ def test_torque_twist_loop_units_and_conventions() -> None:
     assert np.all(np.diff(loop.twist[:11]) > 0) and up[-1] == pytest.approx(RATED)
     assert loop.plot().axes
     assert ARCSEC * 60 == pytest.approx(ARCMIN)
+    text = repr(loop)
+    assert "array" not in text and "points=41" in text
+    assert f"rigidity={s['rigidity_Nm_per_arcmin']:.6g} N m/arcmin" in text
 
 
 def test_bad_input_is_a_clear_error() -> None:

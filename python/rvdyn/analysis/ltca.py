@@ -169,7 +169,7 @@ class LtcaResult:
         return fig  # type: ignore[return-value]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class TransmissionError:
     """TE over one mesh period, forward (+torque) and reverse (-torque), loaded and at a light
     load (unloaded) [rad]; ``crank_angle`` [rad], ``period`` [rad]. ``extremes[curve]`` holds
@@ -197,6 +197,12 @@ class TransmissionError:
         """Peak-to-peak of each curve [rad]: its refined largest minus smallest TE (at least
         the samples' own peak-to-peak)."""
         return {k: float(e["max"] - e["min"]) for k, e in self.extremes.items()}
+
+    def __repr__(self) -> str:
+        # The figures an engineer reads, not the arrays.
+        pp = ", ".join(f"{k} {v / ARCSEC:.4g}" for k, v in self.peak_to_peak().items())
+        return (f"TransmissionError(points={self.crank_angle.size}, period={self.period:.6g} rad, "
+                f"torque={self.torque:.6g} N m, peak_to_peak_arcsec={{{pp}}}, window={self.window:.6g} rad)")
 
     def lost_motion(self) -> np.ndarray:
         """Difference of the reverse and forward TE at each crank angle [rad] (the lost motion
@@ -228,7 +234,7 @@ class TransmissionError:
         return fig  # type: ignore[return-value]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class TwistLoop:
     """The torque-twist loop at one crank angle: ``torque`` [N m], ``twist`` [rad] (positive
     with positive torque), ``tangent_stiffness`` [N m/rad]; catalogue ``rigidity`` [N m/rad],
@@ -272,6 +278,13 @@ class TwistLoop:
             "lost_motion_arcmin": self.lost_motion / ARCMIN,
             "backlash_arcmin": self.backlash / ARCMIN,
         }
+
+    def __repr__(self) -> str:
+        s = self.summary()
+        return (f"TwistLoop(crank_angle={self.crank_angle:.6g} rad, rated_torque={self.rated_torque:.6g} N m, "
+                f"points={self.torque.size}, rigidity={s['rigidity_Nm_per_arcmin']:.6g} N m/arcmin, "
+                f"lost_motion={s['lost_motion_arcmin']:.4g} arcmin, backlash={s['backlash_arcmin']:.4g} arcmin, "
+                f"friction={self.friction})")
 
     def plot(self, ax: Axes | None = None) -> Figure:
         """The hysteresis loop: twist [arcmin] against torque [kN m]."""
