@@ -3,6 +3,7 @@ loads for FEA, the analyze command; checked against a slow dynamic run of the sa
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import subprocess
@@ -156,6 +157,13 @@ def test_analyze_command_writes_figures_loads_and_summary(tmp_path: Path) -> Non
     assert set(summary["te_peak_to_peak_arcsec"]) == {"forward", "reverse", "unloaded_forward",
                                                       "unloaded_reverse"}
     assert "use points >= 84" in r.stderr
+    # The forward TE's largest harmonics, each with its order, label and uncertainty (None where
+    # the grid gives no estimate; JSON has no NaN).
+    h = summary["te_harmonics_forward"]
+    assert len(h) == 3 and all(x["amplitude_arcsec"] > 0 and x["order"] > 0 for x in h)
+    assert all(x["uncertainty_arcsec"] is None or x["uncertainty_arcsec"] >= 0 for x in h)
+    assert "NaN" not in (out / "summary.json").read_text()
+    assert "largest TE harmonics (forward)" in (out / "summary.md").read_text()
     # The paper preset by flag.
     r = subprocess.run([sys.executable, "-m", "rvdyn", "analyze", "--preset", "paper", "--out", str(out),
                         "--angles", "6", "--loop-points", "21"], capture_output=True, text=True, timeout=300)
@@ -181,3 +189,33 @@ def test_large_crank_angles_converge_or_say_why() -> None:
     assert far.loaded_pins.tolist() == near.loaded_pins.tolist()
     with pytest.raises(rvdyn.ConvergenceError, match="modulo the mesh period"):
         ltca(Scene.paper("rated"), rated, [60_000.3])
+
+
+def test_te_harmonics_of_a_known_curve_are_exact() -> None:
+    """Harmonics of a TE made of two cosines on the physical preset's grid (336 samples over a
+    mesh period of 2.375 input revolutions): amplitudes and phases exact to round-off, orders
+    k / 2.375, and the pin-pass (k = 23, order 9.684) and sun-mesh (k = 42, order 17.684)
+    labels of the scene's excitation orders; the half-grid uncertainty is round-off too."""
+    real = transmission_error(Scene.physical("rated"), RATED, 336)
+    n = real.crank_angle.size
+    j = np.arange(n)
+    curve = 3e-6 + 2e-6 * np.cos(2 * np.pi * 23 * j / n + 0.4) + 5e-7 * np.cos(2 * np.pi * 42 * j / n - 1.1)
+    te = dataclasses.replace(real, forward=curve)
+    h = te.harmonics("forward", 3)
+    assert [x.harmonic for x in h[:2]] == [23, 42]
+    assert h[0].amplitude == pytest.approx(2e-6, rel=1e-12) and h[0].phase == pytest.approx(0.4, abs=1e-10)
+    assert h[1].amplitude == pytest.approx(5e-7, rel=1e-12) and h[1].phase == pytest.approx(-1.1, abs=1e-10)
+    assert h[2].amplitude < 1e-20
+    assert te.input_turns == pytest.approx(57 / 24, rel=1e-12)
+    assert h[0].order == pytest.approx(23 * 24 / 57, rel=1e-12) and h[0].label == "pin pass"
+    assert h[1].order == pytest.approx(42 * 24 / 57, rel=1e-12) and h[1].label == "sun mesh"
+    assert h[0].uncertainty < 1e-20 and h[1].uncertainty < 1e-20
+    # The paper preset's period is one pin pass: harmonic k is pin pass x k.
+    paper = transmission_error(Scene.paper("rated"), RATED, 24).harmonics("forward", 2)
+    assert paper[0].harmonic == 1 and paper[0].label == "pin pass"
+    with pytest.raises(rvdyn.ParameterError, match="curve must be one of"):
+        te.harmonics("sideways")
+    with pytest.raises(rvdyn.ParameterError, match="count must be"):
+        te.harmonics("forward", 0)
+    with pytest.raises(rvdyn.ParameterError, match="was not computed"):
+        dataclasses.replace(te, unloaded_forward=np.zeros(0)).harmonics("unloaded_forward")

@@ -65,6 +65,7 @@ def run(args: argparse.Namespace) -> int:
     ]
     csv_path, json_path = res.save_fea_loads(out)
     pp = te.peak_to_peak()
+    harmonics = te.harmonics("forward", 3)
     summary = {
         "scene": scene["name"],
         "torque_Nm": res.torque,
@@ -74,6 +75,13 @@ def run(args: argparse.Namespace) -> int:
         **{k: v for k, v in res.summary().items() if not k.startswith("te_")},
         "te_peak_to_peak_arcsec": {k: v / ARCSEC for k, v in pp.items()},
         "te_window_rad": te.window,
+        # The largest harmonics of the forward TE, with the amplitude's aliasing estimate.
+        "te_harmonics_forward": [
+            {"harmonic": h.harmonic, "order": h.order, "label": h.label,
+             "amplitude_arcsec": h.amplitude / ARCSEC,
+             # None where no estimate is made (harmonics from a quarter of the grid up).
+             "uncertainty_arcsec": h.uncertainty / ARCSEC if np.isfinite(h.uncertainty) else None}
+            for h in harmonics],
         "te_mean_arcmin": {"forward": float(te.forward.mean()) / ARCMIN,
                            "reverse": float(te.reverse.mean()) / ARCMIN},
         **loop.summary(),
@@ -94,6 +102,10 @@ def run(args: argparse.Namespace) -> int:
             f" over one mesh period; with the roller sets fixed in the frame the TE repeats only "
             f"after {te.window:.2f} rad ({te.window / te.period:.0f} periods) and differs from "
             f"period to period by their roller-pass ripple"),
+        "- largest TE harmonics (forward): " + "; ".join(
+            f"{(h.label + ' ') if h.label else ''}(order {h.order:.3f}) {h.amplitude / ARCSEC:.3f}"
+            + (f" +- {h.uncertainty / ARCSEC:.3f} arcsec" if np.isfinite(h.uncertainty) else " arcsec (not estimated)")
+            for h in harmonics) + " (+-: the change on halving the grid; --angles refines it)",
         f"- torsional rigidity {summary['rigidity_Nm_per_arcmin']:.1f} N m/arcmin, lost motion "
         f"{summary['lost_motion_arcmin']:.3f} arcmin, backlash {summary['backlash_arcmin']:.3f} arcmin",
         f"- equilibrium: torque balance <= {summary['torque_balance_max']:.1e}, residual <= "
@@ -103,5 +115,5 @@ def run(args: argparse.Namespace) -> int:
         "",
     ]
     (out / "summary.md").write_text("\n".join(md))
-    print("\n".join(md[2:7]))
+    print("\n".join(md[2:8]))
     return 0

@@ -18,7 +18,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["ARCMIN", "ARCSEC", "LtcaResult", "TransmissionError", "TwistLoop", "ltca", "running_friction",
+__all__ = ["ARCMIN", "ARCSEC", "LtcaResult", "TeHarmonic", "TransmissionError", "TwistLoop", "ltca", "running_friction",
            "torque_twist", "tooth_mesh_angles", "transmission_error"]
 
 #: One arc minute and one arc second [rad].
@@ -169,6 +169,24 @@ class LtcaResult:
         return fig  # type: ignore[return-value]
 
 
+@dataclass(frozen=True)
+class TeHarmonic:
+    """One harmonic of a TE curve over its mesh period: ``harmonic`` k (cycles per period),
+    ``order`` (cycles per input revolution), ``amplitude`` [rad] and ``phase`` [rad] of
+    ``amplitude cos(2 pi k (psi - start) / period + phase)``, and the ``label`` of the scene's
+    excitation order it falls on (``""`` if none; :func:`rvdyn.analysis.spectrum.excitation_orders`)."""
+
+    harmonic: int
+    order: float
+    amplitude: float
+    phase: float
+    label: str
+    #: ``2 |X_k - X'_k|`` [rad], ``X'`` from every second sample: how much the coefficient moves
+    #: when the grid is halved, an estimate of its aliasing error (larger than the error for a
+    #: coefficient that converges; NaN for ``k >= N/4`` or an odd ``N``, where none is made).
+    uncertainty: float = float("nan")
+
+
 @dataclass(frozen=True, repr=False)
 class TransmissionError:
     """TE over one mesh period, forward (+torque) and reverse (-torque), loaded and at a light
@@ -192,6 +210,52 @@ class TransmissionError:
     extremes: dict[str, dict[str, float]]
     refined: dict[str, bool]
     window: float
+    #: Input revolutions per mesh period [-] (the order of harmonic k is k over this).
+    input_turns: float = float("nan")
+    #: The scene's excitation orders as (order, label), for the harmonics' labels.
+    excitation: tuple[tuple[float, str], ...] = field(default=(), repr=False)
+
+    def harmonics(self, curve: str = "forward", count: int = 8) -> list[TeHarmonic]:
+        """The ``count`` largest harmonics of ``curve`` (``"forward"``, ``"reverse"``,
+        ``"unloaded_forward"``, ``"unloaded_reverse"``) over the mesh period, largest first.
+
+        The discrete Fourier transform of the samples, which cover exactly one period with the
+        endpoint excluded: ``X_k = (1/N) sum_j TE_j exp(-2 pi i j k / N)``, amplitude ``2 |X_k|``
+        (``|X_k|`` at ``k = N/2``) and phase ``arg X_k``, for ``1 <= k <= N/2``; exact for a
+        curve with no harmonics above ``N/2`` (docs/model.md, "Transmission error harmonics").
+        Harmonics above ``N/2`` fold onto lower ones: refine ``points`` until the amplitudes
+        you read stop changing. The order of harmonic k is ``k / input_turns`` per input
+        revolution; a harmonic within 1e-9 of an excitation order of the scene (pin pass, sun
+        mesh and their harmonics, the shafts' rotations) carries its label. ``uncertainty``
+        estimates each amplitude's aliasing error from the same transform of every second
+        sample."""
+        names = ("forward", "reverse", "unloaded_forward", "unloaded_reverse")
+        if curve not in names:
+            raise ParameterError(f"curve must be one of {names}, got {curve!r}")
+        if not (isinstance(count, (int, np.integer)) and not isinstance(count, bool) and count >= 1):
+            raise ParameterError(f"count must be a whole number >= 1, got {count!r}")
+        y = np.asarray(getattr(self, curve), dtype=float)
+        n = y.size
+        if n < 2:
+            raise ParameterError(f"the {curve} curve has {n} samples: it was not computed (unloaded curves "
+                                 "need a light load) or the grid is too short for a harmonic")
+        x = np.fft.rfft(y) / n
+        # The same coefficients from every second sample (valid below their Nyquist, N/4).
+        half = np.fft.rfft(y[::2]) / (n // 2) if n % 2 == 0 and n >= 8 else np.zeros(0, complex)
+        k = np.arange(1, x.size)
+        amp = 2.0 * np.abs(x[1:])
+        if n % 2 == 0:
+            amp[-1] *= 0.5  # the Nyquist bin has no mirror
+        order = np.argsort(-amp, kind="stable")[: int(count)]
+        out = []
+        for i in order:
+            h = int(k[i])
+            o = h / self.input_turns
+            label = next((lab for oo, lab in self.excitation if abs(oo - o) <= 1e-9 * max(abs(oo), 1.0)), "")
+            unc = 2.0 * float(abs(x[h] - half[h])) if 4 * h < n and h < half.size else float("nan")
+            out.append(TeHarmonic(harmonic=h, order=float(o), amplitude=float(amp[i]),
+                                  phase=float(np.angle(x[h])), label=label, uncertainty=unc))
+        return out
 
     def peak_to_peak(self) -> dict[str, float]:
         """Peak-to-peak of each curve [rad]: its refined largest minus smallest TE (at least
@@ -362,6 +426,21 @@ def _tooth_mesh_angles(sc: Scene, period: float) -> int:
     return max(2, math.ceil(2.0 * period / cycle - 1e-9))
 
 
+def _input_turns(sc: Scene, period: float, ratio: float) -> float:
+    """Input revolutions per ``period`` [rad] of crank angle: the held input turns by
+    ``i / zc`` per crank angle with a first stage, else it is the crank (docs/model.md)."""
+    d = sc.to_dict()
+    zc = int(d["cycloid"]["pins"]) - 1
+    per_crank = abs(ratio) / zc if d.get("stage1") is not None else 1.0
+    return period * per_crank / (2.0 * math.pi)
+
+
+def _excitation(sc: Scene) -> tuple[tuple[float, str], ...]:
+    from .spectrum import excitation_orders
+
+    return tuple((o.order, o.label) for o in excitation_orders(sc, 6))
+
+
 def transmission_error(scene: Scene, torque: float | None = None, points: int | None = None, *,
                        light: float | None = None, start: float = 0.0) -> TransmissionError:
     """TE over one mesh period at ``points`` crank angles, at ``+-torque`` and at the light load
@@ -384,7 +463,9 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
                            extremes={k: {q: float(e[q]) for q in ("max_angle", "max", "min_angle", "min")}
                                      for k, e in d["extremes"].items()},
                            refined={k: bool(e["refined"]) for k, e in d["extremes"].items()},
-                           window=float(solver.te_window))
+                           window=float(solver.te_window),
+                           input_turns=_input_turns(sc, float(d["period"]), float(solver.ratio)),
+                           excitation=_excitation(sc))
     if int(points) < needed:
         warnings.warn(
             f"transmission_error: {int(points)} crank angles per mesh period are fewer than two "
