@@ -86,8 +86,14 @@ fn ltca_work(
                     .ok()
                     .and_then(|v| v.parse().ok())
                     .unwrap_or(1e-6);
-                let te =
-                    ltca.transmission_error(black_box(torque), Some(lf * torque), 360, 0.0, false)?;
+                let te = ltca.transmission_error(
+                    black_box(torque),
+                    Some(lf * torque),
+                    360,
+                    0.0,
+                    1,
+                    false,
+                )?;
                 if std::env::var_os("LTCA_WORK_RESULTS").is_some() {
                     let pp = rvdyn::analysis::ltca::peak_to_peak;
                     println!(

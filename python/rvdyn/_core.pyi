@@ -492,10 +492,11 @@ class LtcaSolver:
     def fea_loads(self) -> tuple[str, str]:
         """Worst load case per disc over every point solved so far: (CSV, JSON)."""
     def transmission_error(self, torque: float, light: float | None, points: int, start: float,
-                           pin_loads: bool = False) -> dict[str, Any]:
-        """TE over one mesh period at +-torque and (unless light is None) +-light [N m], with
-        each curve's extremes located between the crank angles; with ``pin_loads``, key
-        ``pin_loads`` holds per loaded curve ``peak_force`` [N] and ``loaded_pins_min`` per angle."""
+                           pin_loads: bool = False, periods: int = 1) -> dict[str, Any]:
+        """TE over ``periods`` mesh periods (``points`` crank angles each) at +-torque and
+        (unless light is None) +-light [N m], with each curve's extremes located between the
+        crank angles; with ``pin_loads``, key ``pin_loads`` holds per loaded curve
+        ``peak_force`` [N] and ``loaded_pins_min`` per angle."""
     def twist_loop(self, rated: float, crank_angle: float, points: int, friction: bool = True) -> dict[str, Any]:
         """Torque-twist loop with rigidity, lost motion and backlash (with the scene's friction
         unless ``friction`` is false)."""

@@ -94,10 +94,11 @@ impl LtcaSolver {
         Ok((loads_csv(&loads), loads_json(&loads, self.face_width)?))
     }
 
-    /// TE over one mesh period at `points` crank angles from `start` [rad], at +-`torque` and
-    /// (unless `light` is None) +-`light` [N m], with each curve's extremes; with
-    /// `pin_loads`, each loaded curve's peak pin force [N] and fewest loaded pins per angle.
-    #[pyo3(signature = (torque, light, points, start, pin_loads = false))]
+    /// TE over `periods` mesh periods at `points` crank angles per period from `start` [rad],
+    /// at +-`torque` and (unless `light` is None) +-`light` [N m], with each curve's extremes;
+    /// with `pin_loads`, each loaded curve's peak pin force [N] and fewest loaded pins per angle.
+    #[pyo3(signature = (torque, light, points, start, pin_loads = false, periods = 1))]
+    #[allow(clippy::too_many_arguments)]
     fn transmission_error<'py>(
         &mut self,
         py: Python<'py>,
@@ -106,13 +107,16 @@ impl LtcaSolver {
         points: usize,
         start: f64,
         pin_loads: bool,
+        periods: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
         let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
-        let te = py.detach(|| ltca.transmission_error(torque, light, points, start, pin_loads))?;
+        let te = py
+            .detach(|| ltca.transmission_error(torque, light, points, start, periods, pin_loads))?;
         let d = PyDict::new(py);
         let n = te.crank_angle.len();
         d.set_item("crank_angle", f64_array(py, te.crank_angle, vec![n])?)?;
         d.set_item("period", te.period)?;
+        d.set_item("periods", te.periods)?;
         d.set_item("forward", f64_array(py, te.forward, vec![n])?)?;
         d.set_item("reverse", f64_array(py, te.reverse, vec![n])?)?;
         // Empty without the unloaded curves.

@@ -75,6 +75,7 @@ def run(args: argparse.Namespace) -> int:
         **{k: v for k, v in res.summary().items() if not k.startswith("te_")},
         "te_peak_to_peak_arcsec": {k: v / ARCSEC for k, v in pp.items()},
         "te_window_rad": te.window,
+        "te_periods": te.periods,
         # The largest harmonics of the forward TE, with the amplitude's aliasing estimate.
         "te_harmonics_forward": [
             {"harmonic": h.harmonic, "order": h.order, "label": h.label,
@@ -98,10 +99,9 @@ def run(args: argparse.Namespace) -> int:
         f"- TE peak-to-peak: forward {pp['forward'] / ARCSEC:.3f} arcsec, reverse "
         f"{pp['reverse'] / ARCSEC:.3f} arcsec (unloaded {pp['unloaded_forward'] / ARCSEC:.3f} / "
         f"{pp['unloaded_reverse'] / ARCSEC:.3f} arcsec)" + (
-            "" if te.window <= 1.000001 * te.period else
-            f" over one mesh period; with the roller sets fixed in the frame the TE repeats only "
-            f"after {te.window:.2f} rad ({te.window / te.period:.0f} periods) and differs from "
-            f"period to period by their roller-pass ripple"),
+            "" if te.periods == 1 else
+            f" over the {te.periods} mesh periods ({te.window:.2f} rad of crank angle) after which the "
+            f"TE repeats: the roller sets, fixed in the frame, make the periods differ"),
         "- largest TE harmonics (forward): " + "; ".join(
             f"{(h.label + ' ') if h.label else ''}(order {h.order:.3f}) {h.amplitude / ARCSEC:.3f}"
             + (f" +- {h.uncertainty / ARCSEC:.3f} arcsec" if np.isfinite(h.uncertainty) else " arcsec (not estimated)")

@@ -189,15 +189,16 @@ class TeHarmonic:
 
 @dataclass(frozen=True, repr=False)
 class TransmissionError:
-    """TE over one mesh period, forward (+torque) and reverse (-torque), loaded and at a light
-    load (unloaded) [rad]; ``crank_angle`` [rad], ``period`` [rad]. ``extremes[curve]`` holds
-    each curve's largest and smallest TE located between the crank angles: ``max``, ``min``
-    [rad] at ``max_angle``, ``min_angle`` [rad]; ``refined[curve]`` is false where the
-    equilibria depend on the path (a very light load), and the extremes are then the samples'
-    (docs/model.md, "Transmission error"). ``window`` [rad] is the crank angle after which
-    the whole TE repeats: ``period``, or with roller bearings (whose roller sets stay fixed in
-    the frame) a multiple of it, over which the TE differs from period to period by the
-    roller-pass ripple (docs/model.md, "Mesh period")."""
+    """TE over ``periods`` whole mesh periods (by default the ``window`` after which the whole
+    TE repeats), forward (+torque) and reverse (-torque), loaded and at a light load
+    (unloaded) [rad]; ``crank_angle`` [rad], ``period`` (the mesh period) [rad].
+    ``extremes[curve]`` holds each curve's largest and smallest TE located between the crank
+    angles: ``max``, ``min`` [rad] at ``max_angle``, ``min_angle`` [rad]; ``refined[curve]``
+    is false where the equilibria depend on the path (a very light load), and the extremes are
+    then the samples' (docs/model.md, "Transmission error"). ``window`` [rad] is the crank
+    angle after which the whole TE repeats: ``period``, or with roller bearings (whose roller
+    sets stay fixed in the frame) a multiple of it, over which the TE differs from period to
+    period by the roller-pass ripple (docs/model.md, "Mesh period")."""
 
     crank_angle: np.ndarray
     period: float
@@ -210,17 +211,20 @@ class TransmissionError:
     extremes: dict[str, dict[str, float]]
     refined: dict[str, bool]
     window: float
-    #: Input revolutions per mesh period [-] (the order of harmonic k is k over this).
+    #: Mesh periods covered [-].
+    periods: int = 1
+    #: Input revolutions over the ``periods`` covered [-] (the order of harmonic k is k over this).
     input_turns: float = float("nan")
     #: The scene's excitation orders as (order, label), for the harmonics' labels.
     excitation: tuple[tuple[float, str], ...] = field(default=(), repr=False)
 
     def harmonics(self, curve: str = "forward", count: int = 8) -> list[TeHarmonic]:
         """The ``count`` largest harmonics of ``curve`` (``"forward"``, ``"reverse"``,
-        ``"unloaded_forward"``, ``"unloaded_reverse"``) over the mesh period, largest first.
+        ``"unloaded_forward"``, ``"unloaded_reverse"``) over the ``periods`` covered, largest
+        first.
 
-        The discrete Fourier transform of the samples, which cover exactly one period with the
-        endpoint excluded: ``X_k = (1/N) sum_j TE_j exp(-2 pi i j k / N)``, amplitude ``2 |X_k|``
+        The discrete Fourier transform of the samples, which cover whole mesh periods with the
+        endpoint excluded (periodic when they cover the ``window``): ``X_k = (1/N) sum_j TE_j exp(-2 pi i j k / N)``, amplitude ``2 |X_k|``
         (``|X_k|`` at ``k = N/2``) and phase ``arg X_k``, for ``1 <= k <= N/2``; exact for a
         curve with no harmonics above ``N/2`` (docs/model.md, "Transmission error harmonics").
         Harmonics above ``N/2`` fold onto lower ones: refine ``points`` until the amplitudes
@@ -265,7 +269,8 @@ class TransmissionError:
     def __repr__(self) -> str:
         # The figures an engineer reads, not the arrays.
         pp = ", ".join(f"{k} {v / ARCSEC:.4g}" for k, v in self.peak_to_peak().items())
-        return (f"TransmissionError(points={self.crank_angle.size}, period={self.period:.6g} rad, "
+        return (f"TransmissionError(points={self.crank_angle.size}, periods={self.periods}, "
+                f"period={self.period:.6g} rad, "
                 f"torque={self.torque:.6g} N m, peak_to_peak_arcsec={{{pp}}}, window={self.window:.6g} rad)")
 
     def lost_motion(self) -> np.ndarray:
@@ -291,7 +296,8 @@ class TransmissionError:
             ax.plot(np.degrees([e["max_angle"], e["min_angle"]]),
                     (np.array([e["max"], e["min"]]) - y.mean()) / ARCSEC, "o",
                     color=line.get_color(), markersize=3)
-        ax.set_xlabel("crank angle [deg] (one mesh period)")
+        ax.set_xlabel("crank angle [deg] (" + ("one mesh period" if self.periods == 1 else
+                                               f"{self.periods} mesh periods") + ")")
         ax.set_ylabel("TE about its mean [arcsec]")
         ax.set_title(f"transmission error, T = +-{self.torque / 1e3:.2f} kN m")
         ax.legend(fontsize="small")
@@ -427,12 +433,17 @@ def _tooth_mesh_angles(sc: Scene, period: float) -> int:
 
 
 def _input_turns(sc: Scene, period: float, ratio: float) -> float:
-    """Input revolutions per ``period`` [rad] of crank angle: the held input turns by
+    """Input revolutions over ``period`` [rad] of crank angle: the held input turns by
     ``i / zc`` per crank angle with a first stage, else it is the crank (docs/model.md)."""
     d = sc.to_dict()
     zc = int(d["cycloid"]["pins"]) - 1
     per_crank = abs(ratio) / zc if d.get("stage1") is not None else 1.0
     return period * per_crank / (2.0 * math.pi)
+
+
+def _window_periods(window: float, period: float) -> int:
+    """Whole mesh periods in the TE ``window`` [rad] (a whole number by construction)."""
+    return max(1, round(window / period))
 
 
 def _excitation(sc: Scene) -> tuple[tuple[float, str], ...]:
@@ -442,20 +453,31 @@ def _excitation(sc: Scene) -> tuple[tuple[float, str], ...]:
 
 
 def transmission_error(scene: Scene, torque: float | None = None, points: int | None = None, *,
-                       light: float | None = None, start: float = 0.0) -> TransmissionError:
-    """TE over one mesh period at ``points`` crank angles, at ``+-torque`` and at the light load
-    ``+-light`` [N m] (default ``1e-6 torque``) from crank angle ``start`` [rad]. By default
-    ``points`` is 90, or eight per tooth-mesh cycle of an ISO 6336 mesh if that is more
-    (``4 tooth_mesh_angles(scene)``: 336 on the physical preset, whose TE ripples 42 times per
-    period). Each curve's extremes are located between the crank angles (``extremes``)."""
+                       light: float | None = None, start: float = 0.0, window: bool = True) -> TransmissionError:
+    """TE at ``points`` crank angles per mesh period, at ``+-torque`` and at the light load
+    ``+-light`` [N m] (default ``1e-6 torque``) from crank angle ``start`` [rad], over the
+    ``window`` after which the whole TE repeats (``window=False``: one mesh period). By
+    default ``points`` is 90, or eight per tooth-mesh cycle of an ISO 6336 mesh if that is
+    more (``4 tooth_mesh_angles(scene)``: 336 on the physical preset, whose TE ripples 42
+    times per period). Each curve's extremes are located between the crank angles of each
+    period (``extremes``).
+
+    With roller bearings, whose roller sets stay fixed in the frame, the TE repeats only
+    after several mesh periods (twelve on the physical preset: ``window``) and differs from
+    period to period; one period alone can show a peak-to-peak far from the whole curve's (the
+    physical preset's unloaded TE: 0.085 arcsec over the first period, 0.204 over the window).
+    The cost grows with the periods covered (about 1.7 s on the physical preset, 0.14 s for one
+    period)."""
     sc = _scene(scene)
     solver = _core.LtcaSolver(sc._compiled, 1e-12)
-    needed = _tooth_mesh_angles(sc, float(solver.mesh_period))
+    period = float(solver.mesh_period)
+    needed = _tooth_mesh_angles(sc, period)
     if points is None:
         points = max(90, 4 * needed)
     t = abs(_rated(sc, torque))
     lt = 1e-6 * t if light is None else abs(_float("light", light, "N m"))
-    d = solver.transmission_error(t, lt, int(points), _float("start", start, "rad"))
+    periods = _window_periods(float(solver.te_window), period) if window else 1
+    d = solver.transmission_error(t, lt, int(points), _float("start", start, "rad"), False, periods)
     te = TransmissionError(crank_angle=d["crank_angle"], period=float(d["period"]),
                            forward=d["forward"], reverse=d["reverse"],
                            unloaded_forward=d["unloaded_forward"],
@@ -463,8 +485,9 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
                            extremes={k: {q: float(e[q]) for q in ("max_angle", "max", "min_angle", "min")}
                                      for k, e in d["extremes"].items()},
                            refined={k: bool(e["refined"]) for k, e in d["extremes"].items()},
-                           window=float(solver.te_window),
-                           input_turns=_input_turns(sc, float(d["period"]), float(solver.ratio)),
+                           window=float(solver.te_window), periods=int(d["periods"]),
+                           input_turns=_input_turns(sc, float(d["period"]) * int(d["periods"]),
+                                                    float(solver.ratio)),
                            excitation=_excitation(sc))
     if int(points) < needed:
         warnings.warn(

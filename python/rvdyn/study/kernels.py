@@ -116,8 +116,8 @@ class FunctionKernel:
 
 #: Metrics of :class:`LtcaKernel` (SI units; the conventions of docs/model.md, "Quasi-static analysis").
 LTCA_METRICS: dict[str, str] = {
-    "te_pp_forward": "transmission error peak-to-peak over one mesh period at +torque, extremes located between the crank angles [rad]",
-    "te_pp_reverse": "transmission error peak-to-peak over one mesh period at -torque, extremes located between the crank angles [rad]",
+    "te_pp_forward": "transmission error peak-to-peak over the window after which it repeats (or one mesh period) at +torque, extremes located between the crank angles [rad]",
+    "te_pp_reverse": "transmission error peak-to-peak over the window after which it repeats (or one mesh period) at -torque, extremes located between the crank angles [rad]",
     "peak_pin_force": "largest pin force over the crank angles and discs at the torque [N]",
     "loaded_pins_min": "fewest pins in contact on any disc over the crank angles [-]",
     "torsional_rigidity": "catalogue torsional rigidity of the torque-twist loop [N m/rad]",
@@ -135,13 +135,17 @@ class LtcaKernel:
     a sample cheap; raised to two per tooth-mesh cycle of an ISO 6336 mesh,
     :func:`rvdyn.analysis.tooth_mesh_angles`, so that the TE's extremes are found).
     twist_points: points of the torque-twist loop 0 -> +T -> -T -> 0, taken at crank_angle
-    [rad]. A sample whose analysis fails (no equilibrium, invalid geometry)
-    raises its error, which the study records in the sample's row."""
+    [rad]. window: the TE over the window after which it repeats (with roller bearings, whose
+    roller sets stay fixed in the frame, several mesh periods: twelve on the physical preset
+    without pin errors, twelve times the cost) or, with ``window=False``, over one mesh period.
+    A sample whose analysis fails (no equilibrium, invalid geometry) raises its error, which the
+    study records in the sample's row."""
 
     torque: float | None = None
     points: int = 24
     twist_points: int = 41
     crank_angle: float = 0.0
+    window: bool = True
     name: str = field(default="ltca", init=False)
 
     def __post_init__(self) -> None:
@@ -154,6 +158,8 @@ class LtcaKernel:
             raise ParameterError(f"ltca kernel: twist_points must be an int >= 5, got {self.twist_points!r}")
         if not (isinstance(self.crank_angle, (int, float)) and math.isfinite(self.crank_angle)):
             raise ParameterError(f"ltca kernel: crank_angle must be a finite angle [rad], got {self.crank_angle!r}")
+        if not isinstance(self.window, bool):
+            raise ParameterError(f"ltca kernel: window must be True or False, got {self.window!r}")
 
     @property
     def metrics(self) -> tuple[str, ...]:
@@ -166,13 +172,15 @@ class LtcaKernel:
         # mesh period with the pin loads of its +torque equilibria, then the loop. The unloaded
         # TE is not a metric and is not computed.
         from .. import _core
-        from ..analysis.ltca import _rated, _scene, _tooth_mesh_angles
+        from ..analysis.ltca import _rated, _scene, _tooth_mesh_angles, _window_periods
 
         sc = _scene(scene)
         torque = abs(_rated(sc, self.torque))
         solver = _core.LtcaSolver(sc._compiled, 1e-12)
-        points = max(self.points, _tooth_mesh_angles(sc, float(solver.mesh_period)))
-        te = solver.transmission_error(torque, None, points, 0.0, True)
+        period = float(solver.mesh_period)
+        points = max(self.points, _tooth_mesh_angles(sc, period))
+        periods = _window_periods(float(solver.te_window), period) if self.window else 1
+        te = solver.transmission_error(torque, None, points, 0.0, True, periods)
         pp = {k: float(e["max"] - e["min"]) for k, e in te["extremes"].items()}
         pins = te["pin_loads"]["forward"]
         loop = solver.twist_loop(torque, float(self.crank_angle), self.twist_points)

@@ -107,10 +107,12 @@ impl LtcaPoint {
 /// Transmission error over one mesh period in both drive directions.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TransmissionError {
-    /// Crank angles \[rad\] (one full mesh period, endpoint excluded).
+    /// Crank angles \[rad\] (`periods` whole mesh periods, endpoint excluded).
     pub crank_angle: Vec<f64>,
     /// Period of the mesh in crank angle \[rad\].
     pub period: f64,
+    /// Mesh periods covered.
+    pub periods: usize,
     /// TE at `+torque` (forward drive) \[rad\].
     pub forward: Vec<f64>,
     /// TE at `-torque` (reverse drive) \[rad\].
@@ -160,6 +162,52 @@ pub struct TeExtremes {
     pub unloaded_forward: Option<CurveExtremes>,
     /// At `-light` (`None` without the unloaded curves).
     pub unloaded_reverse: Option<CurveExtremes>,
+}
+
+impl CurveExtremes {
+    /// The extremes of two stretches of one curve together.
+    fn join(self, other: CurveExtremes) -> CurveExtremes {
+        CurveExtremes {
+            max: if other.max.value > self.max.value {
+                other.max
+            } else {
+                self.max
+            },
+            min: if other.min.value < self.min.value {
+                other.min
+            } else {
+                self.min
+            },
+            refined: self.refined && other.refined,
+        }
+    }
+}
+
+impl TransmissionError {
+    /// `next` (the following crank angles of the same curves) appended.
+    fn join(&mut self, next: TransmissionError) {
+        self.periods += next.periods;
+        self.crank_angle.extend(next.crank_angle);
+        self.forward.extend(next.forward);
+        self.reverse.extend(next.reverse);
+        self.unloaded_forward.extend(next.unloaded_forward);
+        self.unloaded_reverse.extend(next.unloaded_reverse);
+        let (a, b) = (&mut self.extremes, next.extremes);
+        a.forward = a.forward.join(b.forward);
+        a.reverse = a.reverse.join(b.reverse);
+        let opt = |x: Option<CurveExtremes>, y: Option<CurveExtremes>| match (x, y) {
+            (Some(x), Some(y)) => Some(x.join(y)),
+            (x, y) => x.or(y),
+        };
+        a.unloaded_forward = opt(a.unloaded_forward, b.unloaded_forward);
+        a.unloaded_reverse = opt(a.unloaded_reverse, b.unloaded_reverse);
+        if let (Some(p), Some(q)) = (self.pin_loads.as_mut(), next.pin_loads) {
+            for (x, y) in [(&mut p.forward, q.forward), (&mut p.reverse, q.reverse)] {
+                x.peak_force.extend(y.peak_force);
+                x.loaded_pins_min.extend(y.loaded_pins_min);
+            }
+        }
+    }
 }
 
 /// Peak-to-peak of a series.
@@ -706,15 +754,51 @@ impl Ltca {
         Ok(point)
     }
 
-    /// Transmission error over one mesh period at `points` crank angles, at `+-torque`
-    /// (loaded) and, with `light`, at `+-light` (unloaded: a light load that keeps the flanks
-    /// in contact, as in single-flank testing) [N m]; without it the unloaded curves are empty
-    /// (and their extremes `None`). Each curve's extremes are located between the crank
-    /// angles ([`te_extremes`]).
+    /// Transmission error over `periods` consecutive mesh periods from crank angle `start`
+    /// \[rad\], at `points` crank angles per period, at `+-torque` (loaded) and, with `light`,
+    /// at `+-light` (unloaded: a light load that keeps the flanks in contact, as in
+    /// single-flank testing) [N m]; without it the unloaded curves are empty (and their
+    /// extremes `None`). Each curve's extremes are located between the crank angles of each
+    /// period ([`te_extremes`]) and are the largest and smallest over the periods.
+    ///
+    /// One period suffices where the whole static state repeats after it; with roller sets
+    /// fixed in the frame it repeats only after [`Ltca::te_window`], a whole number of periods
+    /// over which the TE differs from period to period (docs/model.md, "Mesh period").
     ///
     /// With `pin_loads`, the peak pin force and the fewest loaded pins of each loaded curve's
     /// equilibria are kept too ([`TePinLoads`]), which saves a [`Ltca::sweep`] at `+-torque`.
+    ///
+    /// Errors: `Parameter` for fewer than 2 points or no period, `Convergence` as
+    /// [`Ltca::solve`].
     pub fn transmission_error(
+        &mut self,
+        torque: f64,
+        light: Option<f64>,
+        points: usize,
+        start: f64,
+        periods: usize,
+        pin_loads: bool,
+    ) -> Result<TransmissionError> {
+        if periods == 0 {
+            return Err(RvdynError::Parameter(
+                "transmission error needs at least one mesh period".into(),
+            ));
+        }
+        require_finite("start", start)?;
+        // Each period as the one-period analysis from its own start (its sweeps from the
+        // kinematic pose, its extremes located within it), then joined.
+        let period = self.mesh_period;
+        let mut all = self.te_one_period(torque, light, points, start, pin_loads)?;
+        for k in 1..periods {
+            let next =
+                self.te_one_period(torque, light, points, start + k as f64 * period, pin_loads)?;
+            all.join(next);
+        }
+        Ok(all)
+    }
+
+    /// [`Ltca::transmission_error`] over the one mesh period from `start`.
+    fn te_one_period(
         &mut self,
         torque: f64,
         light: Option<f64>,
@@ -789,6 +873,7 @@ impl Ltca {
         Ok(TransmissionError {
             crank_angle: angles,
             period,
+            periods: 1,
             forward,
             reverse,
             unloaded_forward,
@@ -1049,8 +1134,9 @@ fn mesh_period_turns(scene: &Scene) -> (u64, u64, bool) {
 /// `2 pi / Z` for every set of `Z` rollers: `w` a multiple of `2 pi zc / Z`. The window is the
 /// least common multiple of the mesh period and these, as fractions of a turn
 /// (`lcm(a/b, c/d) = lcm(a, c) / gcd(b, d)` in lowest terms). Physical preset: 23/24, 23/20
-/// and 23/26 of a turn give 23/2, 72.26 rad, twelve mesh periods; [`Ltca::transmission_error`]
-/// covers one mesh period (docs/model.md, "Mesh period").
+/// and 23/26 of a turn give 23/2, 72.26 rad, twelve mesh periods, which
+/// [`Ltca::transmission_error`] covers when asked for that many periods (docs/model.md, "Mesh
+/// period").
 pub fn te_window(scene: &Scene) -> f64 {
     let (n, d, _) = mesh_period_turns(scene);
     let mut w = reduced((n, d));

@@ -223,7 +223,7 @@ fn te_repeats_over_the_mesh_period_and_converges_with_refinement() {
     let mut pp = Vec::new();
     for n in [8, 16, 32, 64, 128] {
         let te = ltca
-            .transmission_error(rated(), Some(1.0), n, 0.0, false)
+            .transmission_error(rated(), Some(1.0), n, 0.0, 1, false)
             .unwrap();
         pp.push(peak_to_peak(&te.forward));
     }
@@ -309,7 +309,7 @@ fn figures() {
             let lo = pts.iter().map(|p| p.loaded_pins[0]).min().unwrap();
             let hi = pts.iter().map(|p| p.loaded_pins[0]).max().unwrap();
             let te = ltca
-                .transmission_error(rated(), Some(1e-6 * rated()), 90, 0.0, false)
+                .transmission_error(rated(), Some(1e-6 * rated()), 90, 0.0, 1, false)
                 .unwrap();
             let lp = ltca.twist_loop(rated(), 0.0, 81).unwrap();
             println!(
@@ -1017,10 +1017,10 @@ fn te_extremes_are_refined_between_the_samples_and_checked_along_the_path() {
     s.cycloid.d_rp = -2e-5;
     let mut ltca = Ltca::new(&s).unwrap();
     let coarse = ltca
-        .transmission_error(rated(), None, 8, 0.0, false)
+        .transmission_error(rated(), None, 8, 0.0, 1, false)
         .unwrap();
     let fine = ltca
-        .transmission_error(rated(), None, 64, 0.0, false)
+        .transmission_error(rated(), None, 64, 0.0, 1, false)
         .unwrap();
     let (a, b) = (coarse.extremes.forward, fine.extremes.forward);
     assert!(a.refined && b.refined);
@@ -1092,8 +1092,8 @@ fn te_pin_loads_equal_the_sweep_reports() {
     s.cycloid.d_rp = -2e-5;
     let t = rated();
     let mut ltca = Ltca::new(&s).unwrap();
-    let with = ltca.transmission_error(t, None, 24, 0.0, true).unwrap();
-    let without = ltca.transmission_error(t, None, 24, 0.0, false).unwrap();
+    let with = ltca.transmission_error(t, None, 24, 0.0, 1, true).unwrap();
+    let without = ltca.transmission_error(t, None, 24, 0.0, 1, false).unwrap();
     assert!(without.pin_loads.is_none());
     let loads = with.pin_loads.clone().unwrap();
     for (k, (a, b)) in with.forward.iter().zip(&without.forward).enumerate() {
@@ -1119,4 +1119,74 @@ fn te_pin_loads_equal_the_sweep_reports() {
         }
     }
     println!("largest relative difference of the peak pin force: {worst:.2e}");
+}
+
+/// Several periods are the one-period analyses from each period's start, joined: the curves
+/// end to end, each curve's extremes the largest and smallest of the periods', the pin loads
+/// end to end (physical preset, whose TE differs from period to period: its roller sets are
+/// fixed in the frame). No period is a `Parameter` error.
+#[test]
+fn te_over_several_periods_joins_the_periods() {
+    let s = Scene::physical("rated").unwrap();
+    let t = rated();
+    let mut ltca = Ltca::new(&s).unwrap();
+    let p = ltca.mesh_period();
+    let two = ltca
+        .transmission_error(t, Some(1e-6 * t), 24, 0.0, 2, true)
+        .unwrap();
+    let first = ltca
+        .transmission_error(t, Some(1e-6 * t), 24, 0.0, 1, true)
+        .unwrap();
+    let second = ltca
+        .transmission_error(t, Some(1e-6 * t), 24, p, 1, true)
+        .unwrap();
+    assert_eq!(two.periods, 2);
+    assert_eq!(two.crank_angle.len(), 48);
+    // The same equilibria; the exact gaps' warm starts carried from call to call move them by
+    // round-off: loaded 1e-16 rad, at the light load (whose solves stop at a round-off floor
+    // relative to a tiny load) up to 4e-13 rad per angle and 1.3e-11 rad (2e-5 of the
+    // peak-to-peak) in the located extremes.
+    let close = |a: &[f64], b: &[f64]| {
+        a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-14)
+    };
+    assert!(close(&two.forward[..24], &first.forward));
+    assert!(close(&two.forward[24..], &second.forward));
+    let light_diff = two.unloaded_reverse[24..]
+        .iter()
+        .zip(&second.unloaded_reverse)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    println!("unloaded: largest difference {light_diff:.2e} rad");
+    assert!(light_diff < 1e-9, "{light_diff}");
+    assert!((two.crank_angle[24] - p).abs() < 1e-12);
+    // The periods differ (roller-pass ripple), so the joined extremes are a real choice.
+    let (a, b, c) = (&two.extremes, &first.extremes, &second.extremes);
+    assert!((b.forward.max.value - c.forward.max.value).abs() > 1e-9);
+    let near = |x: f64, y: f64| (x - y).abs() < 1e-14;
+    assert!(near(
+        a.forward.max.value,
+        b.forward.max.value.max(c.forward.max.value)
+    ));
+    assert!(near(
+        a.reverse.min.value,
+        b.reverse.min.value.min(c.reverse.min.value)
+    ));
+    let ua = a.unloaded_forward.unwrap();
+    let (ub, uc) = (b.unloaded_forward.unwrap(), c.unloaded_forward.unwrap());
+    let upp = ua.max.value - ua.min.value;
+    let ud = (ua.max.value - ub.max.value.max(uc.max.value)).abs();
+    println!("unloaded extremes: {ud:.2e} rad of {upp:.2e}");
+    assert!(ud < 1e-4 * upp, "{ud} {upp}");
+    let loads = two.pin_loads.unwrap();
+    assert_eq!(loads.forward.peak_force.len(), 48);
+    let later = second.pin_loads.unwrap().forward.peak_force;
+    assert!(
+        loads.forward.peak_force[24..]
+            .iter()
+            .zip(&later)
+            .all(|(x, y)| (x - y).abs() < 1e-9 * y)
+    );
+    assert!(matches!(
+        ltca.transmission_error(t, None, 24, 0.0, 0, false),
+        Err(RvdynError::Parameter(_))
+    ));
 }
