@@ -466,7 +466,7 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
     after several mesh periods (twelve on the physical preset: ``window``) and differs from
     period to period; one period alone can show a peak-to-peak far from the whole curve's (the
     physical preset's unloaded TE: 0.085 arcsec over the first period, 0.204 over the window).
-    The cost grows with the periods covered (about 1.7 s on the physical preset, 0.14 s for one
+    The cost grows with the periods covered (about 1.5 s on the physical preset, 0.14 s for one
     period)."""
     sc = _scene(scene)
     solver = _core.LtcaSolver(sc._compiled, 1e-12)

@@ -463,13 +463,26 @@ impl Ltca {
         // this one; with two or three previous solutions along the same torque (or the same
         // crank angle), extrapolated by the polynomial through them in the crank angle (or the
         // torque).
+        // The last solution's deflection carried unchanged: the second start where the
+        // extrapolation lands off by more than the load (bodies floating in their clearances
+        // at a light load; docs/model.md, "Newton iteration").
+        let held: Option<Vec<f64>> = match self.history.as_slice() {
+            [last, _, ..] => Some(
+                kin.iter()
+                    .zip(&last.deflection)
+                    .map(|(a, b)| a + b)
+                    .collect(),
+            ),
+            _ => None,
+        };
         let mut q = predictor(&self.history, psi, torque, kin);
-        let mut solve = |q: &mut [f64], options: &NewtonOptions| {
+        let mut solve = |q: &mut [f64], second: Option<&[f64]>, options: &NewtonOptions| {
             equilibrium(
                 st,
                 psi,
                 torque,
                 q,
+                second,
                 self.k_ref,
                 options,
                 &mut self.work,
@@ -477,13 +490,13 @@ impl Ltca {
                 self.capture,
             )
         };
-        let first = match solve(&mut q, &self.options) {
+        let first = match solve(&mut q, held.as_deref(), &self.options) {
             Ok(r) => Ok(r),
             Err(e) if !self.history.is_empty() => {
                 // A warm start from far away can be worse than the kinematic pose.
                 let _ = e;
                 let mut q2 = kin_here.clone();
-                let r = solve(&mut q2, &self.options);
+                let r = solve(&mut q2, None, &self.options);
                 if r.is_ok() {
                     q = q2;
                 }
@@ -502,7 +515,7 @@ impl Ltca {
                     ..self.options
                 };
                 let mut q3 = kin_here.clone();
-                match solve(&mut q3, &regularised) {
+                match solve(&mut q3, None, &regularised) {
                     Ok(r) => {
                         q = q3;
                         r

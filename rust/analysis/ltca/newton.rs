@@ -371,11 +371,17 @@ impl Scratch {
 /// evaluation's: the same as a fresh evaluation there, except that the pins the separation
 /// bound skipped keep their last exact gaps (their forces are zero either way).
 #[allow(clippy::too_many_arguments)]
+///
+/// `second_start`: unknowns to start from instead of `q` when the residual at `q` exceeds the
+/// load and is larger than there (a warm start extrapolated from solutions whose bodies float
+/// in their clearances can land far off, docs/model.md, "Newton iteration"); one evaluation
+/// more where it is tried.
 pub fn equilibrium(
     st: &mut Statics,
     psi: f64,
     torque: f64,
     q: &mut [f64],
+    second_start: Option<&[f64]>,
     k_ref: f64,
     opts: &NewtonOptions,
     work: &mut Work,
@@ -440,6 +446,37 @@ pub fn equilibrium(
     }
     st.eval(psi, q, torque, r, k, work, capture.then_some(&mut *state))?;
     let (mut rmax, mut r2) = norms(r, scale, force_scale);
+    if let Some(alt) = second_start
+        && alt.len() == n
+        && rmax > load
+    {
+        qt.copy_from_slice(alt);
+        if st
+            .eval(
+                psi,
+                qt,
+                torque,
+                rt,
+                kt,
+                work,
+                capture.then_some(&mut *trial_state),
+            )
+            .is_ok()
+        {
+            let (m2, n2) = norms(rt, scale, force_scale);
+            if m2 < rmax {
+                q.copy_from_slice(qt);
+                std::mem::swap(r, rt);
+                std::mem::swap(k, kt);
+                std::mem::swap(state, trial_state);
+                (rmax, r2) = (m2, n2);
+            } else {
+                last_at_q = false;
+            }
+        } else {
+            last_at_q = false;
+        }
+    }
     let mut mu = 0.0;
     let mut it = 0;
     while rmax > done {
