@@ -213,6 +213,8 @@ def test_te_harmonics_of_a_known_curve_are_exact() -> None:
     # The paper preset's period is one pin pass: harmonic k is pin pass x k.
     paper = transmission_error(Scene.paper("rated"), RATED, 24).harmonics("forward", 2)
     assert paper[0].harmonic == 1 and paper[0].label == "pin pass"
+    with pytest.raises(rvdyn.ParameterError, match="window must be True"):
+        transmission_error(Scene.paper("rated"), RATED, 24, window="yes")  # type: ignore[arg-type]
     with pytest.raises(rvdyn.ParameterError, match="curve must be one of"):
         te.harmonics("sideways")
     with pytest.raises(rvdyn.ParameterError, match="count must be"):

@@ -469,6 +469,8 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
     The cost grows with the periods covered (about 1.5 s on the physical preset, 0.14 s for one
     period)."""
     sc = _scene(scene)
+    if not isinstance(window, bool):
+        raise ParameterError(f"window must be True (the whole window) or False (one mesh period), got {window!r}")
     solver = _core.LtcaSolver(sc._compiled, 1e-12)
     period = float(solver.mesh_period)
     needed = _tooth_mesh_angles(sc, period)
