@@ -281,23 +281,36 @@ class TransmissionError:
 
     def plot(self, ax: Axes | None = None) -> Figure:
         """TE in arcsec about its mean, both directions, loaded and unloaded, with each curve's
-        extremes (dots)."""
+        extremes (dots). Several mesh periods are drawn over one another against the crank
+        angle within the period (the TE ripples tens of times per period: the whole window
+        side by side would be a solid band), so that the spread between periods shows."""
         from ..plotting import new_figure
 
         fig, ax = new_figure((8.0, 4.5)) if ax is None else (ax.figure, ax)
-        x = np.degrees(self.crank_angle)
+        n = self.crank_angle.size // max(self.periods, 1)
+        start = float(self.crank_angle[0]) if self.crank_angle.size else 0.0
+
+        def phase(angle: np.ndarray) -> np.ndarray:
+            return np.degrees(start + np.mod(np.asarray(angle) - start, self.period))
+
         for name, style in (("forward", "-"), ("reverse", "-"), ("unloaded_forward", "--"),
                             ("unloaded_reverse", "--")):
             y = getattr(self, name)
-            (line,) = ax.plot(x, (y - y.mean()) / ARCSEC, style,
-                              label=f"{name.replace('_', ' ')} (mean {y.mean() / ARCMIN:+.2f} arcmin)")
+            if y.size == 0:
+                continue
+            rows = (y - y.mean()).reshape(-1, n) / ARCSEC
+            x = np.degrees(self.crank_angle[:n])
+            label = f"{name.replace('_', ' ')} (mean {y.mean() / ARCMIN:+.2f} arcmin)"
+            (line,) = ax.plot(x, rows[0], style, lw=1.0 if self.periods == 1 else 0.6, label=label)
+            for row in rows[1:]:
+                ax.plot(x, row, style, lw=0.6, color=line.get_color(), alpha=0.5)
             # The extremes located between the crank angles (the peak-to-peak's ends).
             e = self.extremes[name]
-            ax.plot(np.degrees([e["max_angle"], e["min_angle"]]),
+            ax.plot(phase(np.array([e["max_angle"], e["min_angle"]])),
                     (np.array([e["max"], e["min"]]) - y.mean()) / ARCSEC, "o",
-                    color=line.get_color(), markersize=3)
+                    color=line.get_color(), markersize=4)
         ax.set_xlabel("crank angle [deg] (" + ("one mesh period" if self.periods == 1 else
-                                               f"{self.periods} mesh periods") + ")")
+                                               f"within the mesh period; {self.periods} periods overlaid") + ")")
         ax.set_ylabel("TE about its mean [arcsec]")
         ax.set_title(f"transmission error, T = +-{self.torque / 1e3:.2f} kN m")
         ax.legend(fontsize="small")
