@@ -83,6 +83,10 @@ def test_physical_both_directions_te_and_modifications() -> None:
     for key in ("forward", "unloaded_forward"):
         other = key.replace("forward", "reverse")
         assert pp[key] == pytest.approx(pp[other], rel=1e-9), key
+    # The plot overlays the twelve periods against the crank angle within the period.
+    ax = te.plot().axes[0]
+    assert len(ax.lines) == 4 * 12 + 4
+    assert max(float(np.max(line.get_xdata())) for line in ax.lines) < math.degrees(te.period)
     finer = transmission_error(scene, RATED, 4 * rvdyn.analysis.tooth_mesh_angles(scene)).peak_to_peak()
     for key in pp:
         assert finer[key] == pytest.approx(pp[key], rel=1e-8), key
