@@ -131,7 +131,7 @@ class LtcaKernel:
 
     torque: output torque [N m] (None: the scene's constant load; its magnitude is used for
     the two drive directions and as the rated torque of the twist loop). points: crank angles
-    over one mesh period for the transmission error and the pin loads (small by default to keep
+    per mesh period for the transmission error and the pin loads (small by default to keep
     a sample cheap; raised to two per tooth-mesh cycle of an ISO 6336 mesh,
     :func:`rvdyn.analysis.tooth_mesh_angles`, so that the TE's extremes are found).
     twist_points: points of the torque-twist loop 0 -> +T -> -T -> 0, taken at crank_angle
