@@ -797,7 +797,6 @@ impl Ltca {
                 "transmission error needs at least one mesh period".into(),
             ));
         }
-        require_finite("start", start)?;
         // Each period as the one-period analysis from its own start (its sweeps from the
         // kinematic pose, its extremes located within it), then joined.
         let period = self.mesh_period;

@@ -1191,6 +1191,33 @@ fn te_over_several_periods_joins_the_periods() {
     ));
 }
 
+/// Newton from `start` (and `second`) at `psi` under `t`: the unknowns and the force
+/// evaluations it took.
+fn newton_from(
+    ltca: &mut Ltca,
+    psi: f64,
+    t: f64,
+    start: &[f64],
+    second: Option<&[f64]>,
+) -> (Vec<f64>, usize) {
+    let mut q = start.to_vec();
+    let before = ltca.statics.evaluations;
+    equilibrium(
+        &mut ltca.statics,
+        psi,
+        t,
+        &mut q,
+        second,
+        ltca.k_ref,
+        &ltca.options,
+        &mut ltca.work,
+        &mut ltca.scratch,
+        false,
+    )
+    .unwrap();
+    (q, ltca.statics.evaluations - before)
+}
+
 /// Newton's second start (the last solution's deflection carried unchanged): tried only when
 /// the residual at the first start exceeds the load, and then Newton runs from the better of
 /// the two. At a light load (1e-7 rated, bodies floating in their clearances) a first start
@@ -1211,27 +1238,9 @@ fn second_start_is_taken_when_the_first_lands_beyond_the_load() {
     let overshot: Vec<f64> = (0..kin.len())
         .map(|i| kin[i] + 30.0 * (q0[i] - kin0[i]))
         .collect();
-    let mut run = |start: &[f64], second: Option<&[f64]>| {
-        let mut q = start.to_vec();
-        let before = ltca.statics.evaluations;
-        equilibrium(
-            &mut ltca.statics,
-            psi,
-            t,
-            &mut q,
-            second,
-            ltca.k_ref,
-            &ltca.options,
-            &mut ltca.work,
-            &mut ltca.scratch,
-            false,
-        )
-        .unwrap();
-        (q, ltca.statics.evaluations - before)
-    };
-    let (q_held, n_held) = run(&held, None);
-    let (q_both, n_both) = run(&overshot, Some(&held));
-    let (_, n_over) = run(&overshot, None);
+    let (q_held, n_held) = newton_from(&mut ltca, psi, t, &held, None);
+    let (q_both, n_both) = newton_from(&mut ltca, psi, t, &overshot, Some(&held));
+    let (_, n_over) = newton_from(&mut ltca, psi, t, &overshot, None);
     let apart = |a: &[f64], b: &[f64]| {
         a.iter()
             .zip(b)
@@ -1249,25 +1258,8 @@ fn second_start_is_taken_when_the_first_lands_beyond_the_load() {
     let t = rated();
     let (q1, _) = ltca.solve_unknowns(t, 0.3).unwrap();
     let start: Vec<f64> = (0..kin.len()).map(|i| kin[i] + q1[i] - kin0[i]).collect();
-    let mut run = |second: Option<&[f64]>| {
-        let mut q = start.clone();
-        let before = ltca.statics.evaluations;
-        equilibrium(
-            &mut ltca.statics,
-            psi,
-            t,
-            &mut q,
-            second,
-            ltca.k_ref,
-            &ltca.options,
-            &mut ltca.work,
-            &mut ltca.scratch,
-            false,
-        )
-        .unwrap();
-        (q, ltca.statics.evaluations - before)
-    };
-    let (a, b) = (run(None), run(Some(&overshot)));
+    let a = newton_from(&mut ltca, psi, t, &start, None);
+    let b = newton_from(&mut ltca, psi, t, &start, Some(&overshot));
     assert_eq!(a.1, b.1);
     assert!(apart(&a.0, &b.0) < 1e-15);
 }
