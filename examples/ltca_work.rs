@@ -16,7 +16,8 @@
 //! unloaded in both directions) or `loop` (N 200-point torque-twist loops at crank angle 0).
 //! Prints the Newton iterations and force evaluations used, and with `LTCA_WORK_RESULTS` set
 //! the results (for A/B comparisons of the same workload). `LTCA_WORK_LIGHT` sets the light
-//! load of `bare` as a fraction of the torque (default 1e-6).
+//! load of `bare` as a fraction of the torque (default 1e-6); `LTCA_WORK_TOL` the Newton
+//! tolerance (`NewtonOptions::tolerance`, default 1e-12 of the load).
 use rvdyn::analysis::ltca::Ltca;
 use rvdyn::dynamics::compliant::default_joints;
 use rvdyn::dynamics::scene::{ContactLawSpec, Scene};
@@ -136,7 +137,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let what = arg(2, "period");
     let n: usize = arg(3, "1").parse()?;
     let torque = s.load.torque(0.0);
-    let mut ltca = Ltca::new(&s)?;
+    let mut options = rvdyn::analysis::ltca::NewtonOptions::default();
+    if let Some(t) = std::env::var("LTCA_WORK_TOL")
+        .ok()
+        .and_then(|v| v.parse().ok())
+    {
+        options.tolerance = t;
+    }
+    let mut ltca = Ltca::with_options(&s, options)?;
     let period = ltca.mesh_period();
     let angles: Vec<f64> = (0..360).map(|i| period * i as f64 / 360.0).collect();
     ltca.solve(torque, 0.0)?;
