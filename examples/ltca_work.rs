@@ -17,7 +17,8 @@
 //! Prints the Newton iterations and force evaluations used, and with `LTCA_WORK_RESULTS` set
 //! the results (for A/B comparisons of the same workload). `LTCA_WORK_LIGHT` sets the light
 //! load of `bare` as a fraction of the torque (default 1e-6); `LTCA_WORK_TOL` the Newton
-//! tolerance (`NewtonOptions::tolerance`, default 1e-12 of the load).
+//! tolerance (`NewtonOptions::tolerance`, default 1e-12 of the load); `LTCA_WORK_REG` turns on
+//! `NewtonOptions::regularise_singular` from the first attempt.
 use rvdyn::analysis::ltca::Ltca;
 use rvdyn::dynamics::compliant::default_joints;
 use rvdyn::dynamics::scene::{ContactLawSpec, Scene};
@@ -143,6 +144,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .and_then(|v| v.parse().ok())
     {
         options.tolerance = t;
+    }
+    if std::env::var_os("LTCA_WORK_REG").is_some() {
+        options.regularise_singular = true;
     }
     let mut ltca = Ltca::with_options(&s, options)?;
     let period = ltca.mesh_period();
