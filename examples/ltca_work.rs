@@ -18,7 +18,8 @@
 //! the results (for A/B comparisons of the same workload). `LTCA_WORK_LIGHT` sets the light
 //! load of `bare` as a fraction of the torque (default 1e-6); `LTCA_WORK_TOL` the Newton
 //! tolerance (`NewtonOptions::tolerance`, default 1e-12 of the load); `LTCA_WORK_REG` turns on
-//! `NewtonOptions::regularise_singular` from the first attempt.
+//! `NewtonOptions::regularise_singular` from the first attempt; `LTCA_WORK_PERIODS` the mesh
+//! periods of `bare` (more than one: 336 angles per period, as `transmission_error`'s window).
 use rvdyn::analysis::ltca::Ltca;
 use rvdyn::dynamics::compliant::default_joints;
 use rvdyn::dynamics::scene::{ContactLawSpec, Scene};
@@ -88,12 +89,17 @@ fn ltca_work(
                     .ok()
                     .and_then(|v| v.parse().ok())
                     .unwrap_or(1e-6);
+                let periods: usize = std::env::var("LTCA_WORK_PERIODS")
+                    .ok()
+                    .and_then(|v| v.parse().ok())
+                    .unwrap_or(1);
+                let points = if periods == 1 { 360 } else { 336 };
                 let te = ltca.transmission_error(
                     black_box(torque),
                     Some(lf * torque),
-                    360,
+                    points,
                     0.0,
-                    1,
+                    periods,
                     false,
                 )?;
                 if std::env::var_os("LTCA_WORK_RESULTS").is_some() {
