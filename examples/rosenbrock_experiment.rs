@@ -35,7 +35,9 @@ use rvdyn::dynamics::record::Channel;
 use rvdyn::dynamics::{RunControl, Scene, SimOptions, simulate};
 use rvdyn::error::{Result, RvdynError};
 use rvdyn::solve::dopri5::VELOCITY_ERROR_TIME;
-use rvdyn::solve::integrator::{Integrator, IntegratorEntry, Method, Settings, Stats};
+use rvdyn::solve::integrator::{
+    Integrator, IntegratorEntry, Method, Settings, Stats, landing_step,
+};
 use rvdyn::solve::jacobian;
 use rvdyn::solve::system::{MechanicalSystem, State};
 
@@ -110,7 +112,6 @@ struct Rosenbrock {
     h: f64,
     h_min: f64,
     h_max: f64,
-    max_steps: u64,
     track_work: bool,
     err_prev: f64,
     /// Accepted steps.
@@ -136,32 +137,13 @@ impl Rosenbrock {
     /// Build from the run settings: `dt` is the first step, `atol` \[m\] and `rtol` the
     /// tolerances.
     fn new(s: &Settings) -> Result<Self> {
-        let bad = |m: String| Err(RvdynError::Parameter(m));
-        if !(s.atol.is_finite() && s.atol > 0.0) {
-            return bad(format!(
-                "atol must be a finite displacement > 0 m, got {}: e.g. 1e-8 m",
-                s.atol
-            ));
-        }
-        if !(s.rtol.is_finite() && s.rtol >= 0.0) {
-            return bad(format!(
-                "rtol must be finite and >= 0, got {}: e.g. 1e-4",
-                s.rtol
-            ));
-        }
-        if !(s.h_min.is_finite() && s.h_min > 0.0 && s.h_min <= s.h_max) {
-            return bad(format!(
-                "the minimum step h_min = {:e} s must be > 0 and at most the largest step {:e} s",
-                s.h_min, s.h_max
-            ));
-        }
+        s.check_adaptive()?;
         Ok(Self {
             rtol: s.rtol,
             atol: s.atol,
             h: s.dt.clamp(s.h_min, s.h_max),
             h_min: s.h_min,
             h_max: s.h_max,
-            max_steps: s.max_steps,
             track_work: s.track_work,
             err_prev: 1e-4,
             accepted: 0,
@@ -329,12 +311,7 @@ impl Rosenbrock {
         }
         loop {
             let remaining = t_end - st.t;
-            let mut h = self.h.min(self.h_max);
-            if h >= remaining {
-                h = remaining;
-            } else if h > 0.5 * remaining {
-                h = 0.5 * remaining;
-            }
+            let h = landing_step(self.h, self.h_max, remaining);
             if h < self.h_min && h < remaining {
                 return Err(self.too_small(st, h, "error test"));
             }
@@ -405,13 +382,6 @@ impl Rosenbrock {
 
 impl Integrator for Rosenbrock {
     fn advance(&mut self, sys: &dyn MechanicalSystem, st: &mut State, t_end: f64) -> Result<()> {
-        if self.accepted >= self.max_steps {
-            return Err(RvdynError::Simulation(format!(
-                "rosenbrock needed more than max_steps = {} steps to reach t = {t_end:.6e} s \
-                 (stopped at t = {:.6e} s): loosen atol/rtol or raise max_steps",
-                self.max_steps, st.t
-            )));
-        }
         if self.accepted == 0 && self.k.nrows() == 0 {
             sys.mark_open_contacts();
         }

@@ -54,7 +54,7 @@
 use crate::error::{Result, RvdynError};
 use crate::solve::dopri5::VELOCITY_ERROR_TIME;
 use crate::solve::generalized_alpha::{Attempt, GeneralizedAlpha};
-use crate::solve::integrator::{Integrator, IntegratorEntry, Settings, Stats};
+use crate::solve::integrator::{Integrator, IntegratorEntry, Settings, Stats, landing_step};
 use crate::solve::system::{MechanicalSystem, State};
 
 /// Registry entry of the error-controlled generalized-alpha.
@@ -109,25 +109,7 @@ impl AdaptiveAlpha {
     /// Build from the run settings: `dt` is the first step, `atol` \[m\] and `rtol` the
     /// tolerances (the Newton tolerance is a tenth of `atol`).
     pub fn new(s: &Settings) -> Result<Self> {
-        let bad = |m: String| Err(RvdynError::Parameter(m));
-        if !(s.atol.is_finite() && s.atol > 0.0) {
-            return bad(format!(
-                "atol must be a finite displacement > 0 m, got {}: e.g. 1e-9 m",
-                s.atol
-            ));
-        }
-        if !(s.rtol.is_finite() && s.rtol >= 0.0) {
-            return bad(format!(
-                "rtol must be finite and >= 0, got {}: e.g. 1e-6",
-                s.rtol
-            ));
-        }
-        if !(s.h_min.is_finite() && s.h_min > 0.0 && s.h_min <= s.h_max) {
-            return bad(format!(
-                "the minimum step h_min = {:e} s must be > 0 and at most the largest step {:e} s",
-                s.h_min, s.h_max
-            ));
-        }
+        s.check_adaptive()?;
         Ok(Self {
             stepper: GeneralizedAlpha::new(s.rho_inf, 0.1 * s.atol, s.track_work)?,
             h: s.dt.clamp(s.h_min, s.h_max),
@@ -216,13 +198,7 @@ impl Integrator for AdaptiveAlpha {
         }
         loop {
             let remaining = t_end - st.t;
-            let mut h = self.h.min(self.h_max);
-            // Land on t_end without a sliver of a last step.
-            if h >= remaining {
-                h = remaining;
-            } else if h > 0.5 * remaining {
-                h = 0.5 * remaining;
-            }
+            let h = landing_step(self.h, self.h_max, remaining);
             if h < self.h_min && h < remaining {
                 return Err(self.too_small(st, h, "error test"));
             }

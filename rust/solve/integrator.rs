@@ -31,6 +31,47 @@ pub struct Settings {
     pub track_work: bool,
 }
 
+impl Settings {
+    /// Check what an adaptive method needs (`Parameter` error naming the setting): `atol` a
+    /// finite displacement > 0 m, `rtol` finite and >= 0, `0 < h_min <= h_max`.
+    pub fn check_adaptive(&self) -> Result<()> {
+        let bad = |m: String| Err(RvdynError::Parameter(m));
+        if !(self.atol.is_finite() && self.atol > 0.0) {
+            return bad(format!(
+                "atol must be a finite displacement > 0 m, got {}: e.g. 1e-9 m",
+                self.atol
+            ));
+        }
+        if !(self.rtol.is_finite() && self.rtol >= 0.0) {
+            return bad(format!(
+                "rtol must be finite and >= 0, got {}: e.g. 1e-6",
+                self.rtol
+            ));
+        }
+        if !(self.h_min.is_finite() && self.h_min > 0.0 && self.h_min <= self.h_max) {
+            return bad(format!(
+                "the minimum step h_min = {:e} s must be > 0 and at most the largest step {:e} s",
+                self.h_min, self.h_max
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The next step of an adaptive method: the proposal `h` \[s\] within `h_max`, landing on the
+/// end time `remaining` s ahead without leaving a sliver of a last step (a step over half of
+/// what remains becomes half of it).
+pub fn landing_step(h: f64, h_max: f64, remaining: f64) -> f64 {
+    let h = h.min(h_max);
+    if h >= remaining {
+        remaining
+    } else if h > 0.5 * remaining {
+        0.5 * remaining
+    } else {
+        h
+    }
+}
+
 /// Work counters of a run: whole numbers, by name (only those a method has).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Stats {

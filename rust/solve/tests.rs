@@ -298,3 +298,52 @@ fn newton_stopped_at_the_local_error_keeps_the_accuracy() {
     );
     assert!(it_loose < it_strict, "{it_loose} >= {it_strict}");
 }
+
+/// The adaptive methods' next step lands on the end time without a sliver: a step over half
+/// of what remains becomes half of it, one at or past the end becomes the rest, and `h_max`
+/// caps the proposal.
+#[test]
+fn landing_step_leaves_no_sliver() {
+    use crate::solve::integrator::landing_step;
+    assert_eq!(landing_step(0.1, 1.0, 1.0), 0.1);
+    assert_eq!(landing_step(0.6, 1.0, 1.0), 0.5);
+    assert_eq!(landing_step(2.0, 5.0, 1.0), 1.0);
+    assert_eq!(landing_step(0.3, 0.2, 1.0), 0.2);
+    assert_eq!(landing_step(0.3, 0.2, 0.25), 0.125);
+}
+
+/// Bad tolerances of an adaptive method are `Parameter` errors naming the setting.
+#[test]
+fn adaptive_settings_are_checked() {
+    use crate::error::RvdynError;
+    use crate::solve::Settings;
+    let ok = Settings {
+        t_end: 1.0,
+        dt: 1e-5,
+        rtol: 1e-6,
+        atol: 1e-9,
+        rho_inf: 0.8,
+        h_max: 1.0,
+        h_min: 1e-13,
+        max_steps: 10,
+        track_work: false,
+    };
+    assert!(ok.check_adaptive().is_ok());
+    for (bad, name) in [
+        (Settings { atol: 0.0, ..ok }, "atol"),
+        (
+            Settings {
+                atol: f64::NAN,
+                ..ok
+            },
+            "atol",
+        ),
+        (Settings { rtol: -1.0, ..ok }, "rtol"),
+        (Settings { h_min: 2.0, ..ok }, "h_min"),
+    ] {
+        match bad.check_adaptive() {
+            Err(RvdynError::Parameter(m)) => assert!(m.contains(name), "{m}"),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+}
