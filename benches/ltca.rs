@@ -76,6 +76,17 @@ fn bench_ltca_physical(c: &mut Criterion) {
     c.bench_function("ltca_physical/twist_loop_200_points", |b| {
         b.iter(|| black_box(ltca.twist_loop(black_box(torque), 0.0, 200).expect("loop")))
     });
+    // `transmission_error(scene, window=False)`: one mesh period at 336 angles, loaded and at
+    // the light load 1e-6 of the torque, both directions, extremes located between the angles
+    // (the window is twelve of these).
+    c.bench_function("ltca_physical/transmission_error_one_period_336", |b| {
+        b.iter(|| {
+            black_box(
+                ltca.transmission_error(black_box(torque), Some(1e-6 * torque), 336, 0.0, 1, false)
+                    .expect("te"),
+            )
+        })
+    });
 }
 
 criterion_group! {
