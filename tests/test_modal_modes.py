@@ -92,7 +92,7 @@ def test_main_torsional_mode_matches_the_free_vibration_of_the_dynamic_model() -
     assert zeta == pytest.approx(m.damping_ratio[0], rel=0.05)
 
 
-def test_modes_over_one_mesh_period() -> None:
+def test_modes_over_one_pin_pitch() -> None:
     scene = rvdyn.Scene.paper("rated").with_compliant_joints()
     sweep = rvdyn.modes_over_mesh(scene, points=6)
     assert sweep.frequency.shape == (6, 16)
@@ -148,7 +148,7 @@ def test_cli_modes_writes_table_energy_campbell_and_summary(tmp_path, capsys) ->
     out = tmp_path / "out"
     # Default: the physical preset (compliant joints: one mode per free coordinate).
     assert main(["modes", "--out", str(out), "--points", "5", "--power", "112e3"]) == 0
-    for name in ("modes.md", "modes.json", "modes_energy.png", "modes_mesh_period.png", "campbell.png"):
+    for name in ("modes.md", "modes.json", "modes_energy.png", "modes_pin_pitch.png", "campbell.png"):
         assert (out / name).exists(), name
     data = json.loads((out / "modes.json").read_text())
     assert len(data["modes"]) == 16 and data["joints"] == "compliant"

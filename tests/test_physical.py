@@ -39,6 +39,14 @@ def test_nonsense_is_a_scene_error_naming_the_field():
         Scene.physical("rated").replace(**{"joints.crank_bearing.clearance": -1e-6})
 
 
+def test_a_steady_start_with_a_ramped_drive_is_a_scene_error():
+    # The ramp holds the input at rest at t = 0 while "steady" puts the carrier at full speed.
+    with pytest.raises(SceneError, match='drive.start = "step"'):
+        Scene.physical("rated").replace(initial="steady")
+    steady = Scene.physical("rated").replace(**{"initial": "steady", "drive.start": "step"})
+    assert steady["initial"] == "steady"
+
+
 def test_channels_efficiency_and_bearing_life(physical_run):
     r = physical_run
     n = len(r.t)
@@ -59,6 +67,12 @@ def test_channels_efficiency_and_bearing_life(physical_run):
         d = life[name]
         assert d["rating"] > 0 and d["equivalent_load"] > 0
         assert math.isfinite(d["l10_hours"]) and d["l10_hours"] > 0
+
+
+def test_bearing_life_without_rollers_says_so():
+    r = simulate(Scene.paper("rated"), 0.002, channels=["motion", "bearings"], progress=False)
+    with pytest.raises(rvdyn.ParameterError, match="rollers"):
+        r.bearing_life()
 
 
 def test_the_default_integrator_of_a_scene_with_rollers_is_accurate() -> None:

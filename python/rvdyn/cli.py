@@ -158,6 +158,7 @@ def info_data() -> dict[str, Any]:
                 "face_width_m": g.face_width,
                 "k1": g.k1,
                 "min_convex_radius_m": g.min_convex_radius,
+                "profile_min_convex_radius_m": _profile_min_convex_radius(g),
                 "pitch_radius_m": g.pitch_radius,
                 "root_curvature_radius_m": float(g.curvature_radius(0.0)),
                 "disc_mass_kg": mass,
@@ -178,6 +179,15 @@ def info_data() -> dict[str, Any]:
     }
 
 
+def _profile_min_convex_radius(g: Any) -> float:
+    """Smallest convex radius of curvature of the disc profile [m], sampled over one lobe (the
+    pin-centre curve's less the generating pin radius, where the profile is convex)."""
+    import numpy as np
+
+    rho = np.asarray(g.curvature_radius(np.linspace(0.0, 2.0 * math.pi / g.lobes, 20001)))
+    return float(rho[rho > 0.0].min())
+
+
 def _core_scene(preset: str) -> Any:
     from rvdyn import _core
 
@@ -188,7 +198,7 @@ def _format_presets(p: dict[str, Any]) -> list[str]:
     a, b = p["paper"], p["physical"]
     rows = [
         ("pin contact law", a["pin_law"], b["pin_law"]),
-        ("pin approach at the rated peak pin force",
+        ("pin approach at the reference pin force (4 T_c/(zp rc'), T_c = T_out/2)",
          f"{a['pin_approach_m'] * 1e6:.1f} um at {a['peak_pin_force_N'] / 1e3:.1f} kN",
          f"{b['pin_approach_m'] * 1e6:.1f} um at {b['peak_pin_force_N'] / 1e3:.1f} kN"),
         ("mesh law", a["mesh_law"], b["mesh_law"]),
@@ -232,8 +242,10 @@ def _format_info(d: dict[str, Any]) -> str:
         f"rp {cyc['pin_circle_radius_m'] * 1e3:g} mm, rrp {cyc['pin_radius_m'] * 1e3:g} mm, "
         f"face {cyc['face_width_m'] * 1e3:g} mm",
         f"    K1 = {cyc['k1']:.4f}, pitch radius rc' = {cyc['pitch_radius_m'] * 1e3:.2f} mm, "
-        f"min convex radius {cyc['min_convex_radius_m'] * 1e3:.3f} mm, "
+        f"profile: smallest convex radius {cyc['profile_min_convex_radius_m'] * 1e3:.3f} mm, "
         f"root radius of curvature {cyc['root_curvature_radius_m'] * 1e3:.3f} mm",
+        f"    pin-centre curve: smallest convex radius {cyc['min_convex_radius_m'] * 1e3:.3f} mm "
+        "(the undercut limit for the pin radius)",
         f"    disc mass {cyc['disc_mass_kg']:.3f} kg, inertia {cyc['disc_inertia_kg_m2']:.4f} "
         "kg m^2 (steel, with bore and holes)",
         f"  involute stage: {inv['z_sun']}/{inv['z_planet']}, {inv['planets']} planets, "

@@ -265,8 +265,15 @@ class Result:
         from ``t_start`` [s] (default: the steady part). The equivalent load weights
         ``|F|^(10/3)`` by the bearing's revolutions (relative rotation of its rings); the life
         holds if the window repeats. Needs the ``"bearings"`` and ``"motion"`` channels and a
-        scene whose bearings are built from rollers (``rollers``)."""
+        scene whose bearings are built from rollers (``rollers``): ``ParameterError`` if none is;
+        a bearing family without rollers is left out."""
         c_ecc, c_crank = _core.CompiledScene.from_json(json.dumps(self.scene)).bearing_ratings()
+        if c_ecc is None and c_crank is None:
+            raise ParameterError(
+                "no bearing of this scene is built from rollers, so there is no ISO 281 rating: "
+                "give joints.eccentric_bearing.rollers (and joints.crank_bearing.rollers), as "
+                "Scene.physical does; the bearing forces are in eccentric_bearing_force and "
+                "crank_bearing_force")
         i0 = int(np.searchsorted(self.t, self._steady_start(t_start)))
         t = self.t[i0:]
         duration = float(t[-1] - t[0])

@@ -84,8 +84,8 @@ mod tests {
             let l = classical_levers(&g, psi);
             let moment: f64 = f.iter().zip(&l).map(|(a, b)| a * b).sum();
             assert!((moment - t_c).abs() < 1e-9 * t_c);
-            // notes 2.1: F_max ~ 4 T_c / (zp rc') = 35.35 kN for T_c = 0.5 x 43.9 kN m x ...;
-            // the sum over 24 pins approximates the integral to a few per cent.
+            // F_max ~ 4 T_c / (zp rc') = 33.29 kN for this T_c (20.68 kN m); the sum over 24
+            // pins approximates the integral to a few per cent.
             let f_max = f.iter().cloned().fold(0.0, f64::max);
             let closed = 4.0 * t_c / (24.0 * g.pitch_radius());
             assert!((f_max / closed - 1.0).abs() < 0.05, "{f_max} {closed}");

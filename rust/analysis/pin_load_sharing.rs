@@ -274,8 +274,8 @@ mod tests {
 pub struct PhysicsSummary {
     /// Pin law kind (`impact`, `palmgren`, `line`).
     pub pin_law: String,
-    /// Classical peak pin force `4 T_c / (zp rc')` at rated load, `T_c` half the output
-    /// torque \[N\].
+    /// Reference pin force `4 T_c / (zp rc')` at rated load, `T_c` half the output torque \[N\]
+    /// (a round reference: the pins' share of the torque gives the classical peak 6 % lower).
     pub peak_pin_force: f64,
     /// Approach of the pin law at that force, at the classical peak-load pin \[m\].
     pub pin_approach: f64,

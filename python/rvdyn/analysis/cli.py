@@ -107,7 +107,9 @@ def run(args: argparse.Namespace) -> int:
             + (f" +- {h.uncertainty / ARCSEC:.3f} arcsec" if np.isfinite(h.uncertainty) else " arcsec (not estimated)")
             for h in harmonics) + " (+-: the change on halving the grid; --angles refines it)",
         f"- torsional rigidity {summary['rigidity_Nm_per_arcmin']:.1f} N m/arcmin, lost motion "
-        f"{summary['lost_motion_arcmin']:.3f} arcmin, backlash {summary['backlash_arcmin']:.3f} arcmin",
+        f"{summary['lost_motion_arcmin']:.3f} arcmin, backlash {summary['backlash_arcmin']:.3f} arcmin "
+        f"(the loop runs to +-{abs(res.torque):.1f} N m, taken as the rated torque: rigidity between "
+        f"the +-rated points, lost motion within +-3 % of it)",
         f"- equilibrium: torque balance <= {summary['torque_balance_max']:.1e}, residual <= "
         f"{summary['residual_max']:.1e} (relative)",
         "",

@@ -380,8 +380,10 @@ class TwistLoop:
         s = self.summary()
         ax.set_xlabel("output twist [arcmin]")
         ax.set_ylabel("output torque [kN m]")
-        ax.set_title(f"torque-twist: rigidity {s['rigidity_Nm_per_arcmin']:.0f} N m/arcmin, "
-                     f"lost motion {s['lost_motion_arcmin']:.3f}', backlash {s['backlash_arcmin']:.3f}'")
+        # Two lines: on one the backlash and its unit ran past a 6.5 in figure.
+        ax.set_title(f"torque-twist: rigidity {s['rigidity_Nm_per_arcmin']:.0f} N m/arcmin\n"
+                     f"lost motion {s['lost_motion_arcmin']:.3f} arcmin, backlash {s['backlash_arcmin']:.3f} arcmin",
+                     fontsize="medium")
         return fig  # type: ignore[return-value]
 
 

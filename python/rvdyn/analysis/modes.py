@@ -3,8 +3,8 @@ equilibrium (docs/model.md, "Modal analysis").
 
 :func:`modes` gives the natural frequencies, damping ratios, mode shapes with named
 coordinates and the share of strain energy in each contact family and bearing family at one
-crank angle; :func:`modes_over_mesh` follows them over one mesh period (the stiffness varies
-with the crank angle). The command ``rvdyn modes`` writes both with the Campbell diagram.
+crank angle; :func:`modes_over_mesh` follows them over a range of crank angle, by default one
+pin pitch (the stiffness varies with the crank angle). The command ``rvdyn modes`` writes both with the Campbell diagram.
 """
 
 from __future__ import annotations
@@ -255,6 +255,8 @@ class MeshSweep:
     energy_share: np.ndarray
     part_names: list[str]
     period: float
+    #: True when ``period`` is the default, one pin pitch ``2 pi / zp``.
+    pin_pitch: bool = False
 
     def variation(self) -> np.ndarray:
         """Peak-to-peak of each mode's frequency over the sweep relative to its mean."""
@@ -270,18 +272,23 @@ class MeshSweep:
         deg = np.degrees(self.crank_angle)
         for m in range(self.frequency.shape[1]):
             ax.plot(deg, self.frequency[:, m], lw=1)
+        span = (f"one pin pitch, {math.degrees(self.period):.2f} deg of crank" if self.pin_pitch
+                else f"{math.degrees(self.period):.2f} deg of crank")
         ax.set(xlabel="crank angle [deg]", ylabel="natural frequency [Hz]", yscale="log",
-               title=f"modes over one mesh period ({math.degrees(self.period):.2f} deg of crank), "
-                     f"{self.torque:.4g} N m")
+               title=f"modes over {span}, {self.torque:.4g} N m")
         return ax
 
 
 def modes_over_mesh(scene: Any, torque: float | None = None, points: int = 25,
                     period: float | None = None, start: float = 0.0) -> MeshSweep:
-    """Modes at ``points`` crank angles over one mesh period from ``start`` [rad] (default
-    period ``2 pi / zp``, one pin pitch of the eccentric: the pin-force pattern of an
-    error-free reducer repeats after it, docs/model.md "Excitation orders"; give ``period``
-    ``= 2 pi`` with pin errors). Torque [N m] as in :func:`modes`."""
+    """Modes at ``points`` crank angles over ``period`` [rad] of crank angle from ``start``
+    [rad]. The default period is one pin pitch ``2 pi / zp``: the pin-force pattern of an
+    error-free reducer repeats after it (docs/model.md "Excitation orders"). With ISO 6336
+    meshes the tooth-mesh cycle (``2 pi zc / (zp z_planet)``, 8.2 deg of crank on the paper's
+    reducer) is shorter, so a pin pitch covers its single- and double-tooth zones, but the whole
+    pattern repeats only after the mesh period (``rvdyn.ltca(...).mesh_period``, 23/24 of a
+    turn on the physical preset); with pin errors only after ``2 pi``. Give ``period`` to
+    sweep either. Torque [N m] as in :func:`modes`."""
     scene = _scene(scene)
     t = scene_torque(scene) if torque is None else _finite("torque", torque, "N m")
     if not isinstance(points, (int, np.integer)) or points < 2:
@@ -292,7 +299,7 @@ def modes_over_mesh(scene: Any, torque: float | None = None, points: int = 25,
     psi = _finite("start", start, "rad") + per * np.arange(points) / points
     res = [Modes._from_core(d) for d in _core.modes(scene.to_json(), t, [float(p) for p in psi])]
     return MeshSweep(t, psi, np.array([r.frequency for r in res]), np.array([r.damping_ratio for r in res]),
-                     np.array([r.energy_share for r in res]), res[0].part_names, per)
+                     np.array([r.energy_share for r in res]), res[0].part_names, per, period is None)
 
 
 def _as_list(values: Sequence[float] | np.ndarray) -> list[float]:
@@ -320,6 +327,9 @@ def add_cli_arguments(p: Any) -> None:
                    help="input speed range [deg/s] of the Campbell diagram (default: the paper's "
                    "3.3-5.5 km/h, 8328-13880 deg/s)")
     p.add_argument("--points", type=int, default=200, help="speeds in the Campbell diagram (default 200)")
+    p.add_argument("--harmonics", type=int, default=8,
+                   help="pin-pass and sun-mesh harmonics in the Campbell diagram (default 8: the ISO "
+                   "mesh stiffness is a rectangular wave with strong higher harmonics)")
     p.add_argument("--out", default="rvdyn-out", metavar="DIR", help="output folder (default rvdyn-out)")
 
 
@@ -348,7 +358,7 @@ def run_cli(args: Any) -> int:
     sweep = modes_over_mesh(scene, m.torque, points=25, start=args.crank_angle)
     speeds = None if args.speeds is None else np.radians(np.linspace(args.speeds[0], args.speeds[1], args.points))
     cd = campbell(scene, speeds, power=args.power, torque=None if args.power is not None else m.torque,
-                  crank_angle=args.crank_angle, points=args.points)
+                  crank_angle=args.crank_angle, harmonics=args.harmonics, points=args.points)
     written = []
 
     def save(fig: Any, name: str) -> None:
@@ -361,7 +371,7 @@ def run_cli(args: Any) -> int:
     ax = m.plot_energy()
     save(ax.figure, "modes_energy.png")
     ax = sweep.plot()
-    save(ax.figure, "modes_mesh_period.png")
+    save(ax.figure, "modes_pin_pitch.png")
     ax = cd.plot()
     save(ax.figure, "campbell.png")
     crossings = cd.table()
@@ -369,7 +379,7 @@ def run_cli(args: Any) -> int:
         "scene": scene.to_dict().get("name", ""), "joints": scene.to_dict()["joints"]["kind"],
         "torque_N_m": m.torque, "crank_angle_rad": m.crank_angle, "coordinates": m.dof_names,
         "stiffness_parts": m.part_names, "modes": m.table(),
-        "mesh_period_variation": {f"mode {i + 1}": float(v) for i, v in enumerate(sweep.variation())},
+        "pin_pitch_variation": {f"mode {i + 1}": float(v) for i, v in enumerate(sweep.variation())},
         "campbell": {"input_speed_range_rad_s": [float(cd.speeds[0]), float(cd.speeds[-1])],
                      "power_W": args.power, "crossings": crossings},
         "equilibrium_residual": m.residual, "stiffness_split_error": m.split_error,
@@ -383,7 +393,7 @@ def run_cli(args: Any) -> int:
              f"Output torque {m.torque:.6g} N m, crank angle {m.crank_angle:.4g} rad; {len(m)} coordinates "
              f"= {len(m)} modes. Equilibrium residual {m.residual:.2e}; stiffness asymmetry "
              f"{m.stiffness_asymmetry:.1e}.", "", "## Mode table", "", m.to_markdown(), "",
-             "## Over one mesh period", "",
+             f"## Over one pin pitch ({math.degrees(sweep.period):.2f} deg of crank)", "",
              "| mode | peak-to-peak / mean of f |", "|---|---|",
              *[f"| {i + 1} | {100 * v:.2f} % |" for i, v in enumerate(sweep.variation())], "",
              "## Campbell crossings", "",

@@ -150,7 +150,7 @@ def _input_angle(result: Any) -> np.ndarray:
 
 
 def order_spectrum(result: Any, channel: str, window: tuple[float, float] | None = None, *,
-                   index: int | Sequence[int] | None = None, domain: str = "time", harmonics: int = 5,
+                   index: int | Sequence[int] | None = None, domain: str = "time", harmonics: int = 10,
                    tolerance: float = 0.01, peaks: int = 10, threshold: float = 1e-3,
                    detrend: str = "mean", orders: Sequence[ExcitationOrder] | None = None) -> OrderSpectrum:
     """Amplitude spectrum of ``result``'s channel ``channel`` over ``window`` = (t0, t1) [s],

@@ -264,7 +264,8 @@ pub static CHANNELS: &[ChannelSpec] = &[
         shape: &[Dim::Discs],
         unit: "1",
         dtype: Dtype::Int64,
-        doc: "number of pins in contact per disc",
+        doc: "number of pins in contact per disc (force > 0, however small: an unmodified \
+              profile at idle touches about half the pins with forces below 1 N)",
     },
     spec(
         "pin_point",
@@ -383,8 +384,8 @@ pub static CHANNELS: &[ChannelSpec] = &[
         Some(Bearings),
         &[Dim::Cranks, Dim::Xy],
         "N",
-        "force of crank bearing i on its crank centre, fixed frame (0 with rigid crank \
-         bearings or ideal joints)",
+        "force of crank bearing i on its crank centre, fixed frame (ideal joints: the reaction \
+         from the crank's balance; compliant joints with rigid crank bearings: not computed, 0)",
     ),
     spec(
         "eccentric_bearing_force",

@@ -1265,7 +1265,7 @@ pub static FIELDS: &[Field] = &[
         "string",
         "-",
         REQ,
-        "\"rest\" or \"steady\" (steady needs a speed drive)",
+        "\"rest\" or \"steady\" (steady needs a speed drive with a step start)",
         "everything at rest in the kinematic pose, or every body at its kinematic speed",
     ),
 ];

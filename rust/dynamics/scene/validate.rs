@@ -201,6 +201,16 @@ impl Scene {
                         "drive.ramp_time must be > 0 s for a ramp start, got {ramp_time}"
                     ));
                 }
+                // A steady start puts every body at full speed while a ramp holds the input at
+                // rest at t = 0: the two together are not a kinematic state.
+                if start == StartKind::Ramp && self.initial == Initial::Steady {
+                    return err(
+                        "initial = \"steady\" starts every body at full speed, but drive.start = \
+                         \"ramp\" starts the input from rest: set drive.start = \"step\" for a \
+                         steady start, or initial = \"rest\" for a ramp"
+                            .into(),
+                    );
+                }
             }
             Drive::Torque { torque, ramp_time } => {
                 if !(torque.is_finite() && ramp_time.is_finite() && ramp_time >= 0.0) {
