@@ -227,6 +227,29 @@ def test_work_and_memory_are_bounded() -> None:
     assert r.t.shape == (11,)
 
 
+def test_analysis_counts_are_bounded_and_whole() -> None:
+    # A count of 1e12 crank angles, loop points or harmonics aborted the interpreter on
+    # allocation; a negative one raised a bare OverflowError, a float was truncated.
+    from rvdyn.analysis import torque_twist, transmission_error
+    from rvdyn.analysis.campbell import campbell
+    from rvdyn.analysis.spectrum import excitation_orders
+    s = Scene.paper("rated")
+    for bad in (10**12, -5, 2.9, True):
+        with pytest.raises(rvdyn.ParameterError, match="points"):
+            transmission_error(s, 4e4, bad)
+        with pytest.raises(rvdyn.ParameterError, match="points"):
+            torque_twist(s, 4e4, 0.0, bad)
+    for bad in (2**32 - 1, 10**11, -1, 1.5):
+        with pytest.raises(rvdyn.ParameterError, match="harmonics"):
+            excitation_orders(s, bad)
+        with pytest.raises(rvdyn.ParameterError, match="harmonics"):
+            campbell(s, harmonics=bad)
+    # The LTCA's Newton tolerance: looser than 1e-6 of the load is refused, not returned.
+    for tol in (1e-3, 1.0):
+        with pytest.raises(rvdyn.ParameterError, match="tolerance"):
+            rvdyn.ltca(s, 4e4, [0.0], tolerance=tol)
+
+
 def test_damaged_result_files_raise_parameter_error(tmp_path: Path) -> None:
     # Issue 12 D9 (the Result.load part): KeyError, JSONDecodeError, BadZipFile, EOFError...
     good = simulate(Scene.paper("rated"), 1e-3, channels="motion").save(tmp_path / "good.npz")

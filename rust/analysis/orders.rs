@@ -27,6 +27,9 @@ use crate::dynamics::scene::Scene;
 use crate::error::{Result, RvdynError};
 use std::f64::consts::TAU;
 
+/// The most harmonics of each excitation family (two orders each: far beyond any mode).
+pub const MAX_HARMONICS: u32 = 10_000;
+
 /// One excitation order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExcitationOrder {
@@ -65,6 +68,12 @@ pub fn excitation_orders(
         return Err(RvdynError::Parameter(
             "harmonics must be at least 1 (the fundamentals)".into(),
         ));
+    }
+    if harmonics > MAX_HARMONICS {
+        return Err(RvdynError::Parameter(format!(
+            "harmonics = {harmonics} is more than {MAX_HARMONICS}: no model resolves orders that \
+             high; use fewer"
+        )));
     }
     let zp = f64::from(pins);
     let zc = zp - 1.0;

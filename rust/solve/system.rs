@@ -23,6 +23,12 @@ pub trait MechanicalSystem {
     fn deepest_first_touch(&self) -> Option<(f64, String)> {
         None
     }
+    /// Mechanical energy (kinetic + potential) \[J\] at `(t, q, v)`, for an integrator that
+    /// checks the energy balance against the integrated power flows; `None` when the system does
+    /// not know it (the default).
+    fn energy(&self, _t: f64, _q: &[f64], _v: &[f64]) -> Result<Option<f64>> {
+        Ok(None)
+    }
 }
 
 /// The integrated state: coordinates, velocities, accelerations and energy flows.

@@ -16,7 +16,8 @@ import numpy as np
 from .. import _core
 from ..errors import ParameterError
 from .modes import _finite, _scene, scene_torque
-from .spectrum import ExcitationOrder
+from ..plotting import _whole
+from .spectrum import MAX_HARMONICS, ExcitationOrder
 
 __all__ = ["CampbellDiagram", "Crossing", "campbell", "travel_to_input_speed", "PAPER_TRAVEL_RANGE_KMH"]
 
@@ -115,11 +116,11 @@ def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, 
     (4 and 7 are strong at the paper's contact ratio 1.63, and the 4th sun-mesh harmonic meets
     the physical preset's main mode at 8488 deg/s, 2 % above the paper's input speed)."""
     scene = _scene(scene)
+    n_harmonics = _whole("harmonics", harmonics, 1, MAX_HARMONICS)
     if speeds is None:
-        if not isinstance(points, (int, np.integer)) or points < 2:
-            raise ParameterError(f"points must be a whole number >= 2, got {points!r}")
+        n = _whole("points", points, 2, 1_000_000)
         lo, hi = (float(v) for v in travel_to_input_speed(np.array(PAPER_TRAVEL_RANGE_KMH)))
-        speeds = np.linspace(lo, hi, int(points))
+        speeds = np.linspace(lo, hi, n)
     w = np.asarray(speeds, dtype=float).ravel()
     if power is not None and torque is not None:
         raise ParameterError("give power or torque, not both")
@@ -135,7 +136,7 @@ def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, 
         frequency_range = (_finite("frequency_range[0]", frequency_range[0], "Hz"),
                            _finite("frequency_range[1]", frequency_range[1], "Hz"))
     d = _core.campbell_diagram(scene.to_json(), [float(x) for x in w], [float(x) for x in t],
-                               _finite("crank_angle", crank_angle, "rad"), int(harmonics), frequency_range)
+                               _finite("crank_angle", crank_angle, "rad"), n_harmonics, frequency_range)
     orders = [ExcitationOrder(n, int(h), float(o), lab) for n, h, o, lab in d["orders"]]
     crossings = [Crossing(float(s), float(f), orders[int(o)], int(m)) for s, f, o, m in d["crossings"]]
     return CampbellDiagram(w, t, np.asarray(d["frequency"]), np.asarray(d["damping_ratio"]), list(d["modes"]),

@@ -12,6 +12,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import ParameterError
+from ..plotting import _whole
 from ..scene import Scene
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -24,6 +25,8 @@ __all__ = ["ARCMIN", "ARCSEC", "LtcaResult", "TeHarmonic", "TransmissionError", 
 #: One arc minute and one arc second [rad].
 ARCMIN: float = math.pi / (180.0 * 60.0)
 ARCSEC: float = math.pi / (180.0 * 3600.0)
+#: The most crank angles per period or loop points one analysis takes (the core's limit).
+MAX_POINTS: int = 10_000_000
 
 
 def _scene(scene: object) -> Scene:
@@ -397,8 +400,11 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
     later chain started from the kinematic pose (docs/model.md, "Long sweeps in parallel
     chains"): the results do not depend on the number of threads.
 
+    ``tolerance``: Newton's residual target, a fraction of the load scale (``|T| / rp``), in
+    (0, 1e-6]; the balance of every body closes to 1e-9 at the default 1e-12.
+
     Raises ``ConvergenceError`` (naming the crank angle and residual) when no equilibrium is
-    found, ``ParameterError`` for non-finite input.
+    found, ``ParameterError`` for non-finite input or a tolerance outside its range.
     """
     sc = _scene(scene)
     t = _rated(sc, torque)
@@ -489,8 +495,7 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
     solver = _core.LtcaSolver(sc._compiled, 1e-12)
     period = float(solver.mesh_period)
     needed = _tooth_mesh_angles(sc, period)
-    if points is None:
-        points = max(90, 4 * needed)
+    points = max(90, 4 * needed) if points is None else _whole("points", points, 2, MAX_POINTS)
     t = abs(_rated(sc, torque))
     lt = 1e-6 * t if light is None else abs(_float("light", light, "N m"))
     periods = _window_periods(float(solver.te_window), period) if window else 1
@@ -531,8 +536,9 @@ def torque_twist(scene: Scene, rated_torque: float | None = None, crank_angle: f
     (docs/model.md, "Friction in the LTCA")."""
     sc = _scene(scene)
     t = abs(_rated(sc, rated_torque))
+    n = _whole("points", points, 8, MAX_POINTS)
     d = _core.LtcaSolver(sc._compiled, 1e-12).twist_loop(t, _float("crank_angle", crank_angle, "rad"),
-                                                         int(points), bool(friction))
+                                                         n, bool(friction))
     return TwistLoop(crank_angle=float(crank_angle), rated_torque=t, torque=d["torque"],
                      twist=d["twist"], tangent_stiffness=d["tangent_stiffness"],
                      rigidity=float(d["rigidity"]), lost_motion=float(d["lost_motion"]),
@@ -549,11 +555,10 @@ def running_friction(scene: Scene, torque: float | None = None, points: int = 24
     direction (docs/model.md, "Friction in the LTCA")."""
     sc = _scene(scene)
     t = abs(_rated(sc, torque))
-    if int(points) < 1:
-        raise ParameterError(f"points must be at least 1, got {points}")
+    n = _whole("points", points, 1, MAX_POINTS)
     solver = _core.LtcaSolver(sc._compiled, 1e-12)
     period = float(solver.mesh_period)
-    angles = _float("start", start, "rad") + period * np.arange(int(points)) / int(points)
+    angles = _float("start", start, "rad") + period * np.arange(n) / n
     fwd = solver.friction_sweep(t, angles.tolist())
     rev = solver.friction_sweep(-t, angles.tolist())
     i = float(solver.ratio)

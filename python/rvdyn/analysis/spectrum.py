@@ -27,9 +27,13 @@ import numpy as np
 
 from .. import _core
 from ..errors import ParameterError
+from ..plotting import _whole
 
 __all__ = ["ExcitationOrder", "SpectrumPeak", "OrderSpectrum", "excitation_orders", "order_spectrum",
            "plot_order_spectrum"]
+
+#: The most harmonics of each excitation family (the core's limit).
+MAX_HARMONICS: int = 10_000
 
 
 @dataclass(frozen=True)
@@ -115,9 +119,8 @@ def excitation_orders(scene: Any, harmonics: int = 3) -> list[ExcitationOrder]:
     increasing order, with the pin-pass and sun-mesh harmonics 1..``harmonics``
     (docs/model.md, "Excitation orders")."""
     text = _scene_json(scene)
-    if not isinstance(harmonics, (int, np.integer)) or harmonics < 1:
-        raise ParameterError(f"harmonics must be a whole number >= 1, got {harmonics!r}")
-    return [ExcitationOrder(n, int(h), float(o), lab) for n, h, o, lab in _core.excitation_orders(text, int(harmonics))]
+    h_max = _whole("harmonics", harmonics, 1, MAX_HARMONICS)
+    return [ExcitationOrder(n, int(h), float(o), lab) for n, h, o, lab in _core.excitation_orders(text, h_max)]
 
 
 def _scene_json(scene: Any) -> str:

@@ -706,6 +706,7 @@ fn stick(held: Option<f64>, direction: f64, slide: f64) -> f64 {
 pub(crate) fn loop_torques(rated: f64, points: usize) -> Result<(Vec<f64>, f64)> {
     crate::error::require_finite("rated torque", rated)?;
     let rated = rated.abs();
+    super::require_points("loop points", points)?;
     if rated == 0.0 || points < 8 {
         return Err(RvdynError::Parameter(format!(
             "the torque-twist loop needs a rated torque > 0 N m and at least 8 points, got \

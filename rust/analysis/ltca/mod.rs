@@ -289,6 +289,21 @@ pub const SWEEP_CHAIN: usize = 150;
 /// At most this many chains per sweep.
 const MAX_SWEEP_CHAINS: usize = 64;
 
+/// The most crank angles or loop points one analysis takes: ten million solves take hours, and
+/// a count far beyond it (a typo) would otherwise abort on allocation instead of raising.
+pub const MAX_POINTS: usize = 10_000_000;
+
+/// `ParameterError` when `count` of `what` exceeds [`MAX_POINTS`].
+pub(crate) fn require_points(what: &str, count: usize) -> Result<()> {
+    if count > MAX_POINTS {
+        return Err(RvdynError::Parameter(format!(
+            "{what} = {count} is more than the {MAX_POINTS} one analysis takes (it would not fit \
+             in memory or finish): use fewer"
+        )));
+    }
+    Ok(())
+}
+
 /// The warm start at `(psi, torque)` from the previous solutions `history` (newest first):
 /// their deflections from their kinematic poses, extrapolated by the Lagrange polynomial
 /// through the newest ones that lie along the same torque (varying crank angle: linear) or
@@ -797,6 +812,11 @@ impl Ltca {
                 "transmission error needs at least one mesh period".into(),
             ));
         }
+        require_points("crank angles per period", points)?;
+        require_points(
+            "crank angles over the periods",
+            points.saturating_mul(periods),
+        )?;
         // Each period as the one-period analysis from its own start (its sweeps from the
         // kinematic pose, its extremes located within it), then joined.
         let period = self.mesh_period;

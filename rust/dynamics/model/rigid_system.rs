@@ -4,7 +4,7 @@ use crate::dynamics::model::parts::ShaftLoads;
 use crate::dynamics::model::pin_contact::{first_touch_report, mark_open};
 use crate::dynamics::model::rigid::{CARRIER, CRANK, FULL, Forces, LOAD, MOTOR, RigidModel, SUN};
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
-use crate::dynamics::run::sink::{ContactSink, NoSink};
+use crate::dynamics::run::sink::{ContactSink, EnergySink, NoSink};
 use crate::error::Result;
 use crate::solve::MechanicalSystem;
 
@@ -89,6 +89,11 @@ impl<'a> RigidSystem<'a> {
 impl MechanicalSystem for RigidSystem<'_> {
     fn dof(&self) -> usize {
         self.coords.len()
+    }
+
+    fn energy(&self, t: f64, q: &[f64], v: &[f64]) -> Result<Option<f64>> {
+        let o = self.observe(t, q, v, &mut EnergySink)?;
+        Ok(Some(o.kinetic_energy + o.potential_energy))
     }
 
     fn eval(

@@ -48,6 +48,17 @@ pub trait ContactSink {
 pub struct NoSink;
 impl ContactSink for NoSink {}
 
+/// A sink for the mechanical energy only (an integrator's check of the energy balance).
+pub struct EnergySink;
+impl ContactSink for EnergySink {
+    fn wants_energy(&self) -> bool {
+        true
+    }
+    fn wants_bearings(&self) -> bool {
+        false
+    }
+}
+
 /// Lets a generic force routine report into a dynamic sink (the recorder's) when observing.
 pub(crate) struct DynSink<'a>(pub &'a mut dyn ContactSink);
 

@@ -51,7 +51,7 @@ use crate::dynamics::model::pin_contact::{
 };
 use crate::dynamics::model::vec2::{add, perp, rotate, scaled, sub};
 use crate::dynamics::model::{Layout, Observation, ReducerModel};
-use crate::dynamics::run::sink::{ContactSink, DynSink, NoSink};
+use crate::dynamics::run::sink::{ContactSink, DynSink, EnergySink, NoSink};
 use crate::dynamics::scene::{Bearing, Initial, Joints, Scene};
 use crate::error::{Result, RvdynError};
 use crate::solve::MechanicalSystem;
@@ -519,6 +519,11 @@ fn crank_index(i: usize) -> usize {
 impl MechanicalSystem for CompliantModel {
     fn dof(&self) -> usize {
         self.coords.len()
+    }
+
+    fn energy(&self, t: f64, q: &[f64], v: &[f64]) -> Result<Option<f64>> {
+        let o = self.observe(t, q, v, &mut EnergySink)?;
+        Ok(Some(o.kinetic_energy + o.potential_energy))
     }
 
     fn eval(
