@@ -244,6 +244,9 @@ def test_analysis_counts_are_bounded_and_whole() -> None:
             excitation_orders(s, bad)
         with pytest.raises(rvdyn.ParameterError, match="harmonics"):
             campbell(s, harmonics=bad)
+    # A loop too small to twist the reducer gave an infinite rigidity.
+    with pytest.raises(rvdyn.ParameterError, match="round-off"):
+        torque_twist(s, 1e-9, 0.0, 41)
     # The LTCA's Newton tolerance: looser than 1e-6 of the load is refused, not returned.
     for tol in (1e-3, 1.0):
         with pytest.raises(rvdyn.ParameterError, match="tolerance"):

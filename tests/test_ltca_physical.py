@@ -152,6 +152,17 @@ def test_physical_rigidity_is_the_twist_derivative() -> None:
     assert loop.rigidity > 0 and loop.backlash > 0 and loop.lost_motion > loop.backlash
 
 
+def test_backlash_does_not_depend_on_the_loop_torque() -> None:
+    # Backlash is the clearances' twist: loops to 1 N m and 10 N m gave half of it (0.372
+    # arcmin against 0.744) when their zero-torque points sat at 1e-7 of those torques, where the
+    # floating bodies do not settle; the points now take at least 1e-3 N m. The elastic twist
+    # between 1e-3 N m and 4.4e-3 N m (1e-7 rated) is below 1e-4 of the backlash.
+    scene = Scene.physical("rated")
+    rated = torque_twist(scene, RATED, 0.0, 41).backlash
+    for t in (1.0, 10.0, 100.0):
+        assert torque_twist(scene, t, 0.0, 41).backlash == pytest.approx(rated, rel=1e-4)
+
+
 def test_physical_bad_input_is_a_clear_error() -> None:
     scene = Scene.physical("rated")
     with pytest.raises(rvdyn.ParameterError):

@@ -126,6 +126,17 @@ def test_campbell_over_the_paper_speed_range() -> None:
     assert cd.plot().get_ylabel() == "frequency [Hz]"
 
 
+def test_unloaded_equilibria_are_refused_or_flagged() -> None:
+    # At 0 N m every frequency was round-off (the paper's idle scene gave 0.62 Hz) and the
+    # damping ratios NaN without a word; at 1 N m two bodies of the physical preset float.
+    for scene in (rvdyn.Scene.physical("rated"), rvdyn.Scene.paper("idle")):
+        with pytest.raises(rvdyn.ParameterError, match="need a load"):
+            rvdyn.modes(scene, torque=0.0 if scene["name"] == "physical" else None)
+    with pytest.warns(RuntimeWarning, match="2 of 16 modes have no stiffness"):
+        m = rvdyn.modes(rvdyn.Scene.physical("rated"), torque=1.0)
+    assert int(np.sum(np.isnan(m.damping_ratio))) == 2
+
+
 def test_bad_requests() -> None:
     scene = rvdyn.Scene.paper("rated").with_compliant_joints()
     with pytest.raises(rvdyn.ConvergenceError, match="did not converge"):

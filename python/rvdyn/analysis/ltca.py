@@ -539,6 +539,10 @@ def torque_twist(scene: Scene, rated_torque: float | None = None, crank_angle: f
     n = _whole("points", points, 8, MAX_POINTS)
     d = _core.LtcaSolver(sc._compiled, 1e-12).twist_loop(t, _float("crank_angle", crank_angle, "rad"),
                                                          n, bool(friction))
+    if not (math.isfinite(float(d["rigidity"])) and float(d["rigidity"]) > 0.0):
+        raise ParameterError(
+            f"the rated torque {t:.6g} N m twists the reducer by no more than round-off (rigidity "
+            f"{float(d['rigidity'])!r}): give a torque the contacts deflect under, e.g. the scene's rated torque")
     return TwistLoop(crank_angle=float(crank_angle), rated_torque=t, torque=d["torque"],
                      twist=d["twist"], tangent_stiffness=d["tangent_stiffness"],
                      rigidity=float(d["rigidity"]), lost_motion=float(d["lost_motion"]),

@@ -10,6 +10,7 @@ pin pitch (the stiffness varies with the crank angle). The command ``rvdyn modes
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
@@ -195,8 +196,21 @@ def modes(scene: Any, torque: float | None = None, crank_angle: float = 0.0, *,
         return Modes._from_core(_core.modes_state(scene.to_json(), _finite("state time", t_s, "s"),
                                                   _as_list(q), _as_list(v)))
     t = scene_torque(scene) if torque is None else _finite("torque", torque, "N m")
+    if t == 0.0:
+        raise ParameterError(
+            "modes about an equilibrium need a load: at 0 N m the contacts carry nothing and have no "
+            "stiffness (a Hertz law's tangent is zero at zero load), so every frequency would be "
+            "round-off; give a torque (e.g. the rated 43921.3 N m) or state=(t, q, v) of a run")
     psi = _finite("crank_angle", crank_angle, "rad")
-    return Modes._from_core(_core.modes(scene.to_json(), t, [psi])[0])
+    m = Modes._from_core(_core.modes(scene.to_json(), t, [psi])[0])
+    floating = int(sum(bool(r) for r in m.extra["rigid_body"]))
+    if floating and scene["drive.kind"] == "speed":
+        # With the input held every body is tied down once the contacts are loaded.
+        warnings.warn(
+            f"modes: {floating} of {len(m)} modes have no stiffness at {t:.6g} N m (bodies floating in "
+            "their clearances or contacts without load): their frequency is 0 and their damping "
+            "ratio is NaN (not defined); a larger torque closes the clearances", RuntimeWarning, stacklevel=2)
+    return m
 
 
 def modes_at(result: Any, t: float | None = None) -> Modes:

@@ -588,7 +588,7 @@ impl Ltca {
         let (torque, rated) = loop_torques(rated, points)?;
         crate::error::require_finite("crank angle", psi)?;
         self.reset();
-        let eps = 1e-7 * rated;
+        let eps = super::zero_side_torque(rated);
         let mut side = 1.0;
         let mut twist = Vec::with_capacity(points);
         let mut tangent = Vec::with_capacity(points);

@@ -994,7 +994,7 @@ impl Ltca {
         // At zero torque the equilibrium is any pose inside the clearances: the loop takes the
         // limit along its branch (a torque of 1e-7 rated on the side it comes from; the elastic
         // twist at that torque is ~(1e-7)^(2/3) = 2e-5 of the rated one for Hertz contacts).
-        let eps = 1e-7 * rated;
+        let eps = zero_side_torque(rated);
         let mut side = 1.0;
         let sides: Vec<f64> = torque
             .iter()
@@ -1090,6 +1090,18 @@ impl Ltca {
         })
     }
 }
+
+/// The torque [N m] at which a torque-twist loop takes its zero-torque points, on the side it
+/// comes from: 1e-7 of the rated torque, but at least [`ZERO_SIDE_FLOOR`]. Below about 1e-5 N m
+/// the bodies floating in their clearances no longer settle against them (a 1 N m loop's
+/// backlash came out half the clearances' twist); at 1e-3 N m the elastic approach of a roller or
+/// line contact is about 1e-11 m, nothing against micrometre clearances.
+pub(crate) fn zero_side_torque(rated: f64) -> f64 {
+    (1e-7 * rated).max(ZERO_SIDE_FLOOR).min(0.01 * rated)
+}
+
+/// The smallest torque of a loop's zero-torque points [N m] (see [`zero_side_torque`]).
+pub const ZERO_SIDE_FLOOR: f64 = 1e-3;
 
 /// The crank-angle period after which the whole contact pattern repeats \[rad\].
 ///
