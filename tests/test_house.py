@@ -227,6 +227,28 @@ def test_work_and_memory_are_bounded() -> None:
     assert r.t.shape == (11,)
 
 
+def test_scene_sizes_that_leave_no_reducer_are_scene_errors() -> None:
+    # A metre typed for a millimetre was accepted and then blamed on the step or the torque.
+    s = Scene.paper("rated")
+    for change, match in [({"cycloid.d_rp": 1.0}, "d_rp"), ({"cycloid.d_delta": 0.1}, "d_delta"),
+                          ({"discs.1.d_rrp": -0.02}, "d_rrp"),
+                          ({"pin_errors.radius": [0.05] * 24}, "overlap"),
+                          ({"pin_errors.position": [[1.0, 0.0]] * 24}, "pin_errors.position")]:
+        with pytest.raises(rvdyn.SceneError, match=match):
+            s.replace(**change)
+    # Real sizes pass (and the geometry tests' 2 mm shift).
+    s.replace(**{"cycloid.d_rp": -2e-3, "cycloid.d_delta": 1e-4, "pin_errors.radius": [5e-6] * 24})
+    # Options of the wrong kind are refused rather than read loosely.
+    with pytest.raises(rvdyn.ParameterError, match="skip_separated"):
+        simulate(s, 1e-3, skip_separated="no")
+    with pytest.raises(rvdyn.ParameterError, match="t_end"):
+        simulate(s, True)
+    with pytest.raises(rvdyn.ParameterError, match="got -1"):
+        simulate(s, 1e-3, max_samples=-1)
+    with pytest.raises(rvdyn.ParameterError, match="crank_angles"):
+        rvdyn.ltca(s, 4e4, ["a"])
+
+
 def test_analysis_counts_are_bounded_and_whole() -> None:
     # A count of 1e12 crank angles, loop points or harmonics aborted the interpreter on
     # allocation; a negative one raised a bare OverflowError, a float was truncated.

@@ -152,6 +152,15 @@ def test_physical_rigidity_is_the_twist_derivative() -> None:
     assert loop.rigidity > 0 and loop.backlash > 0 and loop.lost_motion > loop.backlash
 
 
+def test_pressures_beyond_the_elastic_limit_warn() -> None:
+    # Ten times the rated torque ran silently at 7.5 GPa; ISO 76's 4000 MPa is the limit now.
+    scene = Scene.physical("rated")
+    with pytest.warns(RuntimeWarning, match="ISO 76"):
+        res = ltca(scene, 10 * RATED, [0.0])
+    assert res.arrays["peak_pressure"].max() > 4e9
+    assert ltca(scene, 2 * RATED, [0.0]).arrays["peak_pressure"].max() < 4e9  # and no warning
+
+
 def test_backlash_does_not_depend_on_the_loop_torque() -> None:
     # Backlash is the clearances' twist: loops to 1 N m and 10 N m gave half of it (0.372
     # arcmin against 0.744) when their zero-torque points sat at 1e-7 of those torques, where the

@@ -82,6 +82,8 @@ def _warn(stats: dict[str, Any]) -> None:
 
 
 def _t_end(t_end: object) -> float:
+    if isinstance(t_end, bool):
+        raise ParameterError(f"t_end must be a time in s, got {t_end!r}")
     try:
         return float(t_end)  # type: ignore[arg-type]
     except (TypeError, ValueError):

@@ -56,7 +56,9 @@ fn set_option(o: &mut SimOptions, key: &str, value: &Bound<'_, PyAny>) -> PyResu
                 ))
             };
             o.max_samples = match value.extract::<crate::python::Whole>() {
-                Ok(crate::python::Whole::Value(n)) => usize::try_from(n).unwrap_or(0),
+                Ok(crate::python::Whole::Value(n)) => {
+                    usize::try_from(n).map_err(|_| too_many(&n.to_string()))?
+                }
                 Ok(crate::python::Whole::TooLarge(text, _)) => return Err(too_many(&text)),
                 Err(_) => return Err(too_many(&super::arrays::short_repr(value, 30))),
             };
@@ -79,7 +81,13 @@ fn set_option(o: &mut SimOptions, key: &str, value: &Bound<'_, PyAny>) -> PyResu
             }
         }
         "skip_separated" => {
-            o.skip_separated = value.is_truthy()?;
+            // A bool only: "no" is truthy, and reading it as True would do the opposite.
+            o.skip_separated = value.extract::<bool>().map_err(|_| {
+                crate::python::parameter_error(format!(
+                    "skip_separated must be True or False, got {}",
+                    super::arrays::short_repr(value, 30)
+                ))
+            })?;
         }
         "step_check" => {
             let name: String = value.extract().map_err(|_| {

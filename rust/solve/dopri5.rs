@@ -18,7 +18,9 @@ pub static ENTRY: IntegratorEntry = IntegratorEntry {
     adaptive: true,
     summary: "Dormand-Prince 5(4), explicit, adaptive step with error control on displacements",
     build: |s: &Settings| {
-        let mut d = Dopri5::new(s.rtol, s.atol, s.dt, s.h_max);
+        s.check_adaptive()?;
+        // The first step is a guess: raised to h_min rather than failing there at once.
+        let mut d = Dopri5::new(s.rtol, s.atol, s.dt.max(s.h_min).min(s.h_max), s.h_max);
         d.h_min = s.h_min;
         d.max_steps = s.max_steps;
         Ok(Box::new(d))

@@ -25,6 +25,9 @@ __all__ = ["ARCMIN", "ARCSEC", "LtcaResult", "TeHarmonic", "TransmissionError", 
 #: One arc minute and one arc second [rad].
 ARCMIN: float = math.pi / (180.0 * 60.0)
 ARCSEC: float = math.pi / (180.0 * 3600.0)
+#: Hertz peak pressure [Pa] above which the LTCA warns: 4000 MPa, the contact stress of the
+#: static load rating of roller bearings (ISO 76), where steel begins to deform permanently.
+ELASTIC_PRESSURE_LIMIT: float = 4.0e9
 #: The most crank angles per period or loop points one analysis takes (the core's limit).
 MAX_POINTS: int = 10_000_000
 
@@ -412,7 +415,10 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
         period = float(_core.LtcaSolver(sc._compiled, 1e-12).mesh_period)
         angles = period * np.arange(90) / 90.0
     else:
-        angles = np.atleast_1d(np.asarray(crank_angles, dtype=float))
+        try:
+            angles = np.atleast_1d(np.asarray(crank_angles, dtype=float))
+        except (TypeError, ValueError) as e:
+            raise ParameterError(f"crank_angles must be real numbers [rad]: {e}") from e
     if angles.ndim != 1 or angles.size == 0:
         raise ParameterError(f"crank_angles must be a non-empty 1-D array [rad], got shape {angles.shape}")
     if not np.all(np.isfinite(angles)):
@@ -427,6 +433,14 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
         if progress is not None:
             progress(min(start + step, angles.size), angles.size)
     arrays = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+    peak = float(arrays["peak_pressure"].max())
+    if peak > ELASTIC_PRESSURE_LIMIT:
+        warnings.warn(
+            f"ltca: the peak Hertz pressure {peak / 1e9:.2f} GPa exceeds {ELASTIC_PRESSURE_LIMIT / 1e9:.1f} GPa, "
+            "the contact stress at which ISO 76 sets the static load rating of roller bearings "
+            "(permanent deformation of about 1e-4 of the roller diameter): the elastic contact laws "
+            "no longer describe these contacts; lower the torque or enlarge the contacts",
+            RuntimeWarning, stacklevel=2)
     fea_csv, fea_json = solver.fea_loads()
     return LtcaResult(torque=t, mesh_period=float(solver.mesh_period), ratio=float(solver.ratio),
                       face_width=float(solver.face_width), arrays=arrays, fea_csv=fea_csv,

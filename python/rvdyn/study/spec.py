@@ -127,6 +127,9 @@ class Criterion:
         for what, v in (("max", self.max), ("min", self.min)):
             if v is not None and not math.isfinite(float(v)):
                 raise ParameterError(f"criterion on {self.metric!r}: {what} must be finite, got {v}")
+        if self.max is not None and self.min is not None and float(self.min) > float(self.max):
+            raise ParameterError(
+                f"criterion on {self.metric!r}: min {self.min} is above max {self.max}, so no value passes")
 
     def passes(self, values: np.ndarray) -> np.ndarray:
         """Boolean mask of values meeting the criterion (NaN, i.e. a failed sample, fails)."""

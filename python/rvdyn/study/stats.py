@@ -99,8 +99,9 @@ def _summary_stat(qs: Sequence[float]) -> Any:
 
 def describe(table: Any, metrics: Sequence[str] | None = None, percentiles: Sequence[float] = (5.0, 50.0, 95.0),
              confidence: float = 0.95, n_resamples: int = 1000, seed: int | None = 0) -> dict[str, dict[str, Any]]:
-    """Per metric: ``n`` (samples that ran), ``failed``, ``mean``, ``std`` (ddof 1) and each
-    percentile ``"p<q>"`` as :class:`Interval` s: percentile bootstrap intervals, all
+    """Per metric: ``n`` (samples with a finite value), ``failed`` (samples without one: the
+    analysis failed, or returned an infinite or undefined value), ``mean``, ``std`` (ddof 1) and
+    each percentile ``"p<q>"`` as :class:`Interval` s: percentile bootstrap intervals, all
     statistics from the same ``n_resamples`` resamples."""
     from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 

@@ -173,7 +173,7 @@ pub static FIELDS: &[Field] = &[
         "number",
         "m",
         ZERO,
-        "finite",
+        "finite; |d_rp| <= rrp (after discs[] overrides)",
         "shift modification (grinding convention: rp -> rp + d_rp)",
     ),
     f(
@@ -182,7 +182,7 @@ pub static FIELDS: &[Field] = &[
         "number",
         "m",
         ZERO,
-        "finite",
+        "finite; |d_rrp| <= rrp (after discs[] overrides)",
         "equidistant modification (rrp -> rrp + d_rrp; positive removes material)",
     ),
     f(
@@ -191,7 +191,7 @@ pub static FIELDS: &[Field] = &[
         "number",
         "rad",
         ZERO,
-        "finite",
+        "finite; |d_delta| rp <= rrp (after discs[] overrides)",
         "rotation modification (the profile turned by this angle)",
     ),
     f(
@@ -290,7 +290,7 @@ pub static FIELDS: &[Field] = &[
         "list of [dx, dy]",
         "m",
         Some("[]"),
-        "empty or one per pin; finite",
+        "empty or one per pin; finite; each at most rrp long; neighbouring pins must not overlap",
         "position error of each pin centre, fixed frame",
     ),
     f(
@@ -299,7 +299,7 @@ pub static FIELDS: &[Field] = &[
         "list of numbers",
         "m",
         Some("[]"),
-        "empty or one per pin; finite",
+        "empty or one per pin; finite; neighbouring pins must not overlap",
         "radius error of each pin (positive = larger pin)",
     ),
     f(

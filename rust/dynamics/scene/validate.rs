@@ -4,6 +4,45 @@
 use super::*;
 
 impl Scene {
+    /// Neighbouring pins, each at its place with its position and radius errors (pin `j` at
+    /// `rp (cos, sin)(2 pi j / zp)`, as the models place them), must not overlap.
+    fn check_pins_apart(&self) -> Result<()> {
+        let zp = self.cycloid.pins as usize;
+        let pe = &self.pin_errors;
+        let pin = |j: usize| {
+            let th = std::f64::consts::TAU * j as f64 / zp as f64;
+            let dp = pe.position.get(j).copied().unwrap_or([0.0, 0.0]);
+            let r = self.cycloid.pin_radius + pe.radius.get(j).copied().unwrap_or(0.0);
+            let rp = self.cycloid.pin_circle_radius;
+            ([rp * th.cos() + dp[0], rp * th.sin() + dp[1]], r)
+        };
+        for (j, dp) in pe.position.iter().enumerate() {
+            let size = dp[0].hypot(dp[1]);
+            if size > self.cycloid.pin_radius {
+                return Err(RvdynError::Scene(format!(
+                    "pin_errors.position[{j}] moves pin {} by {size:.6e} m, more than the pin \
+                     radius {} m: pin errors are micrometres (m)",
+                    j + 1,
+                    self.cycloid.pin_radius
+                )));
+            }
+        }
+        for j in 0..zp {
+            let (a, ra) = pin(j);
+            let (b, rb) = pin((j + 1) % zp);
+            let d = (a[0] - b[0]).hypot(a[1] - b[1]);
+            if d <= ra + rb {
+                return Err(RvdynError::Scene(format!(
+                    "pin_errors: pins {} and {} overlap (centres {d:.6e} m apart, radii {ra:.6e} \
+                     and {rb:.6e} m): pin errors are micrometres (position and radius, m)",
+                    j + 1,
+                    (j + 1) % zp + 1
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// Check the scene as a whole; errors say which field is wrong and how to fix it.
     pub fn validate(&self) -> Result<()> {
         let err = |m: String| Err(RvdynError::Scene(m));
@@ -24,6 +63,25 @@ impl Scene {
                     && !v.is_finite()
                 {
                     return err(format!("discs[{k}].{n} must be finite, got {v}"));
+                }
+            }
+            // Modifications are tens of micrometres; one as large as the pin itself (a metre
+            // typed for a millimetre) leaves no reducer to analyse. The rotation counts by the
+            // arc it moves the profile at the pin circle.
+            let p = self.disc_params(k);
+            let rrp = self.cycloid.pin_radius;
+            let rp = self.cycloid.pin_circle_radius;
+            for (n, v, size) in [
+                ("d_rp", p.d_rp, p.d_rp.abs()),
+                ("d_rrp", p.d_rrp, p.d_rrp.abs()),
+                ("d_delta", p.d_delta, (p.d_delta * rp).abs()),
+            ] {
+                if size > rrp {
+                    return err(format!(
+                        "disc {k}: the modification {n} = {v} moves the profile by {size:.4e} m, \
+                         more than the pin radius {rrp} m; profile modifications are tens of \
+                         micrometres (d_rp, d_rrp e.g. 2e-5 m; d_delta e.g. 1e-4 rad)"
+                    ));
                 }
             }
             crate::geometry::CycloidGeometry::check(self.disc_params(k))?;
@@ -72,6 +130,7 @@ impl Scene {
             self.cycloid.pin_radius,
             &self.pin_errors.radius,
         )?;
+        self.check_pins_apart()?;
         if let Err(e) = crate::geometry::mass::require_density(self.density) {
             return err(format!("scene density: {e}"));
         }
