@@ -140,3 +140,40 @@ def test_dask_reruns_the_task_of_a_dead_worker(monkeypatch: pytest.MonkeyPatch, 
                         samples=6, seed=0, runner=client)
     assert not os.path.exists(marker)  # a worker died ...
     assert list(t["sample"]) == list(range(6)) and (t["error"] == "").all()  # ... and its task ran again
+
+
+def rarely_dying_metric(scene: rvdyn.Scene) -> dict[str, float]:
+    """As :func:`dying_metric`, for the largest d_rrp samples only (above 4e-6 m)."""
+    marker = os.environ.get("RVDYN_TEST_DIE", "")
+    if scene["cycloid.d_rrp"] > 4e-6 and marker and os.path.exists(marker):
+        os._exit(3)
+    return {"y": scene["cycloid.d_rrp"]}
+
+
+@pytest.mark.filterwarnings("ignore:Creating scratch directories is taking:UserWarning")
+def test_dask_samples_that_always_kill_their_worker_are_rows(monkeypatch: pytest.MonkeyPatch,
+                                                            tmp_path: os.PathLike[str]) -> None:
+    # The shared task is scattered to the workers; when every copy died with its worker the
+    # other tasks of the batch were cancelled and the study stopped with a raw
+    # FuturesCancelledError, on every resume again. Now the cancelled tasks run once more with
+    # the shared task sent along: the killing samples are failed rows (so may be tasks queued
+    # on the workers they killed: Dask's allowed-failures), none is dropped, and a resume
+    # without the fault completes the table.
+    distributed = pytest.importorskip("distributed")
+    pytest.importorskip("pyarrow")
+    marker = os.path.join(tmp_path, "die")
+    open(marker, "w").close()
+    monkeypatch.setenv("RVDYN_TEST_DIE", marker)
+    out = os.path.join(tmp_path, "k.parquet")
+    tols = [Tolerance("cycloid.d_rrp", tol=1e-5)]
+    kernel = FunctionKernel(rarely_dying_metric, ("y",))
+    args: dict[str, object] = dict(samples=12, seed=0, chunk_size=12, retries=1, out=out)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=50) as cluster, distributed.Client(cluster) as client:
+        t = rvdyn.study(SCENE, kernel, tols, runner=client, **args)  # type: ignore[arg-type]
+        dies = t["cycloid.d_rrp"] > 4e-6
+        assert list(t["sample"]) == list(range(12)) and dies.any() and (~dies).any()
+        assert t["error"][dies].str.startswith("runner failed").all()
+        os.remove(marker)
+        t2 = rvdyn.study(SCENE, kernel, tols, runner=client, retry_failed=True, **args)  # type: ignore[arg-type]
+    assert list(t2["sample"]) == list(range(12)) and (t2["error"] == "").all()

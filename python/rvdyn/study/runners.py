@@ -139,32 +139,62 @@ class Mapper:
             out += [_Failure(msg)] * (len(items) - len(out))
         return out
 
-    def _run_dask(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
-        if isinstance(fn, functools.partial) and len(fn.args) == 1 and not fn.keywords:
+    def _submit(self, fn: Callable[[Any], Any], items: Sequence[Any], inline: bool = False) -> list[Any]:
+        if not inline and isinstance(fn, functools.partial) and len(fn.args) == 1 and not fn.keywords:
             # Send the shared task (scene, kernel, layout) to every worker once, not with each item.
             if self._scattered is None or self._scattered[0] is not fn.args[0]:
                 [fut] = self.runner.scatter([fn.args[0]], broadcast=True, hash=False)
                 self._scattered = (fn.args[0], fut)
-            futures = self.runner.map(fn.func, [self._scattered[1]] * len(items), list(items), pure=False,
-                                      retries=self.retries)
-        else:
-            futures = self.runner.map(fn, list(items), pure=False, retries=self.retries)
+            return list(self.runner.map(fn.func, [self._scattered[1]] * len(items), list(items), pure=False,
+                                        retries=self.retries))
+        return list(self.runner.map(fn, list(items), pure=False, retries=self.retries))
+
+    def _run_dask(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
         from distributed import wait  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
-        wait(futures)  # type: ignore[no-untyped-call, unused-ignore]
-        done = [f for f in futures if f.status == "finished"]
-        results = iter(self.runner.gather(done, errors="raise")) if done else iter(())
-        out: list[Any] = []
-        for f in futures:
-            if f.status == "finished":
-                out.append(next(results))
-                continue
-            try:  # retries exhausted (KilledWorker, ...) or cancelled
-                exc = f.exception()
-                out.append(_Failure(f"runner failed: {type(exc).__name__}: {exc}"))
-            except Exception as err:  # noqa: BLE001
-                out.append(_Failure(f"runner failed: {type(err).__name__}: {err}"))
-        del futures, done
+        out: list[Any] = [None] * len(items)
+        pending = list(range(len(items)))
+        for attempt in range(2):
+            # The second round sends the shared task with each item: a worker that dies then takes
+            # only its own task along, not the copies every other task depends on.
+            futures = self._submit(fn, [items[i] for i in pending], inline=attempt > 0)
+            try:
+                wait(futures)  # type: ignore[no-untyped-call, unused-ignore]
+            except Exception:  # noqa: BLE001 - cancelled futures; each one's status says which
+                pass
+            # One gather for the finished tasks; a result lost meanwhile (its worker died) is
+            # fetched, or found missing, one by one.
+            done = [f for f in futures if f.status == "finished"]
+            try:
+                got = dict(zip((f.key for f in done), self.runner.gather(done, errors="raise")))
+            except Exception:  # noqa: BLE001
+                got = {}
+            again: list[int] = []
+            for i, f in zip(pending, futures):
+                if f.key in got:
+                    out[i] = got[f.key]
+                    continue
+                if f.status == "finished":
+                    try:
+                        out[i] = f.result()
+                        continue
+                    except Exception:  # noqa: BLE001 - lost with its worker: as a cancelled one
+                        pass
+                if f.status in ("cancelled", "lost", "pending", "finished") and attempt == 0:
+                    # Its input was lost with the workers that held it (a worker that died took
+                    # the shared task's copies along): once more.
+                    again.append(i)
+                else:
+                    try:  # retries exhausted (KilledWorker, ...) or cancelled twice
+                        exc = f.exception()
+                        out[i] = _Failure(f"runner failed: {type(exc).__name__}: {exc}" if exc is not None else
+                                          f"runner failed: task {f.status} (a worker died with it or its input)")
+                    except BaseException as err:  # noqa: BLE001 - CancelledError is a BaseException
+                        out[i] = _Failure(f"runner failed: {type(err).__name__}: {err}")
+            del futures, done, got
+            if not again:
+                break
+            pending = again
         return out
 
     def close(self) -> None:
