@@ -94,6 +94,18 @@ def test_result_arrays_balances_and_plots(tmp_path: Path) -> None:
     assert worst == pytest.approx(res.peak_pin_force, rel=1e-15)
 
 
+def test_single_stage_input_torque_and_balance() -> None:
+    # Without a first stage the cranks are the input. With rigid joints the disc forces never
+    # reached the crank coordinates: input torque 0 and a torque balance of 4.3 %. Lossless
+    # statics give T / i with i = -zc (-1909.6 N m); the compliant model, which always had it
+    # right, agrees. Tolerances: the discrete pins move the input torque by 0.1 % over a pitch.
+    t = 43921.3
+    for scene in (Scene.paper("rated", stage1=None), Scene.paper("rated", stage1=None).with_compliant_joints()):
+        res = ltca(scene, t, [0.0, 0.1])
+        np.testing.assert_allclose(res.arrays["input_torque"], -t / 23, rtol=2e-3)
+        assert np.all(res.arrays["torque_balance"] < 1e-9)
+
+
 def test_zero_load_zero_te_and_reversed_torque_mirrors() -> None:
     scene = Scene.paper("rated")
     zero = ltca(scene, 0.0, [0.0, 0.3])

@@ -1178,6 +1178,17 @@ impl Statics {
     pub fn input_reaction(&self, work: &Work) -> f64 {
         if self.model.mesh.is_some() {
             -work.qf[SUN]
+        } else if self.kind == Kind::Rigid {
+            // Rigid joints, cranks held: the disc forces never reach the crank coordinates.
+            // The disc centres ride on the eccentrics, dO_k/dpsi = z x O_k, and the input
+            // carries minus the forces' virtual work on them (as with friction).
+            let x = &work.x;
+            -(0..self.model.discs.len())
+                .map(|k| {
+                    let dk = self.disc_index(k);
+                    -work.qf[dk] * x[dk + 1] + work.qf[dk + 1] * x[dk]
+                })
+                .sum::<f64>()
         } else {
             -(0..self.cranks)
                 .map(|i| work.qf[self.crank_index(i) + 2])
