@@ -396,7 +396,13 @@ impl Ltca {
         let scale = self.statics.scale.clone();
         let rp = scale[0];
         let load = torque.abs() / rp;
-        let floor = 4.0 * f64::EPSILON * self.k_ref * rp;
+        // The frictionless solver's round-off floor: positions carry about eps times the
+        // largest of them (a crank angle of 48 rad puts the carrier 7 m of arc away).
+        let size = q
+            .iter()
+            .zip(&scale)
+            .fold(rp, |m, (x, l)| m.max((x * l).abs()));
+        let floor = 4.0 * f64::EPSILON * self.k_ref * size;
         let done = (self.options.tolerance * load).max(floor);
         let stalled_ok = (1e-9 * load).max(10.0 * floor);
         let norm = |r: &[f64]| {
@@ -433,6 +439,7 @@ impl Ltca {
             // raised tenfold while the step fails) where K is singular (bodies floating in
             // clearances near zero torque); backtracking on the scaled residual norm.
             let mut accepted = false;
+            let mut round_off = false;
             let mut mu = 0.0;
             for _attempt in 0..14 {
                 let mut a = kt.clone();
@@ -443,6 +450,19 @@ impl Ltca {
                 if !solve_dense(&mut a, &mut dq) {
                     mu = if mu == 0.0 { 1e-9 } else { mu * 10.0 };
                     continue;
+                }
+                // Converged at the round-off floor (as the frictionless solver): a plain Newton
+                // correction that moves no point by more than round-off.
+                if mu == 0.0 && rmax <= stalled_ok {
+                    let moved = dq
+                        .iter()
+                        .zip(&scale)
+                        .fold(0.0f64, |m, (d, l)| m.max((d * l).abs()));
+                    if moved <= super::newton::STEP_ROUND_OFF * f64::EPSILON * size {
+                        accepted = true;
+                        round_off = true;
+                        break;
+                    }
                 }
                 let mut step = 1.0;
                 for _ in 0..20 {
@@ -466,6 +486,9 @@ impl Ltca {
                     break;
                 }
                 mu = if mu == 0.0 { 1e-9 } else { mu * 10.0 };
+            }
+            if round_off {
+                break;
             }
             if !accepted {
                 if rmax <= stalled_ok {

@@ -1153,10 +1153,12 @@ fn mesh_period_turns(scene: &Scene) -> (u64, u64, bool) {
         (true, true) => zp * (zp - 1),
     };
     let pins = (pitches, zp, false);
+    // The ISO law's stiffness varies with the tooth position, and so does tooth friction (the
+    // sliding speed changes along the path of contact) with any mesh law.
     let iso = matches!(
         scene.contact.mesh,
         crate::dynamics::scene::ContactLawSpec::Iso6336 { .. }
-    );
+    ) || scene.friction.mesh > 0.0;
     // Gear errors repeat after whole turns of the sun and planets (gear_errors.rs).
     let gear_units = gear_errors::period_units(scene);
     match (&scene.stage1, iso || gear_units > 1) {

@@ -276,7 +276,7 @@ fn lu_solve(m: &mut [f64], n: usize, b: &mut [f64], amax: f64) -> bool {
 /// 360-angle sweep the third step, where one was needed, was 2-5 ulps after second steps above
 /// 5e4 ulps. Accepting instead of taking a correction changes the unknowns by at most
 /// `16 eps rp`.
-const STEP_ROUND_OFF: f64 = 16.0;
+pub(crate) const STEP_ROUND_OFF: f64 = 16.0;
 
 /// Options of the equilibrium solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
