@@ -287,6 +287,8 @@ fn pack<'py>(py: Python<'py>, pts: &[LtcaPoint]) -> PyResult<Bound<'py, PyDict>>
     d.set_item("loaded_pins", loaded.into_pyarray(py).reshape(vec![n, nd])?)?;
     let rot: Vec<f64> = pts.iter().flat_map(|p| p.disc_rotation.clone()).collect();
     d.set_item("disc_rotation", f64_array(py, rot, vec![n, nd])?)?;
+    let angle: Vec<f64> = pts.iter().flat_map(|p| p.disc_angle.clone()).collect();
+    d.set_item("disc_angle", f64_array(py, angle, vec![n, nd])?)?;
     let disp: Vec<f64> = pts
         .iter()
         .flat_map(|p| p.disc_displacement.iter().flatten().copied())

@@ -66,10 +66,13 @@ class LtcaResult:
     ``transmission_error`` (output minus input/ratio), ``input_torque`` (n,) [rad, rad, rad,
     N m]; per disc and pin ``pin_force``, ``pin_gap``, ``half_width``, ``peak_pressure``
     (n, discs, pins) [N, m, m, Pa]; ``contact_point``, ``contact_normal`` (n, discs, pins, 2)
-    in the disc frame [m, -]; ``loaded_pins`` (n, discs); ``disc_rotation`` (n, discs) [rad];
-    ``disc_displacement`` (n, discs, 2) [m]; ``mesh_force`` (n, cranks) [N];
+    in the disc frame [m, -]; ``loaded_pins`` (n, discs); ``disc_rotation`` (n, discs) [rad]
+    from the kinematic angle; ``disc_angle`` (n, discs) [rad], each disc's angle in the fixed
+    frame (the rotation from the disc frame to the fixed frame);
+    ``disc_displacement`` (n, discs, 2) [m], fixed frame; ``mesh_force`` (n, cranks) [N];
     ``crank_bearing_force`` (n, cranks, 2) and ``eccentric_bearing_force`` (n, cranks, discs, 2)
-    [N] (empty for rigid joints); ``torque_balance``, ``residual`` (n,) relative;
+    [N], fixed frame as in a dynamic run (rotate by ``-disc_angle`` to apply them to a disc mesh
+    with the pin loads; empty for rigid joints); ``torque_balance``, ``residual`` (n,) relative;
     ``iterations`` (n,); ``torsional_stiffness`` (n,) [N m/rad].
     """
 

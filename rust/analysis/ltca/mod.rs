@@ -74,6 +74,9 @@ pub struct LtcaPoint {
     pub loaded_pins: Vec<usize>,
     /// Disc rotation from its kinematic angle \[rad\], per disc.
     pub disc_rotation: Vec<f64>,
+    /// Angle of each disc in the fixed frame \[rad\]: the rotation from the disc frame of the
+    /// pin loads to the fixed frame of the bearing forces.
+    pub disc_angle: Vec<f64>,
     /// Disc centre displacement from its kinematic position \[m\], per disc.
     pub disc_displacement: Vec<[f64; 2]>,
     /// Signed sun/planet mesh force per crank \[N\] (positive on the drive flank).
@@ -696,6 +699,7 @@ impl Ltca {
         let mut pins = Vec::with_capacity(m.discs.len());
         let mut loaded = Vec::new();
         let mut rot = Vec::new();
+        let mut angles = Vec::new();
         let mut disp = Vec::new();
         let mut pin_moment = 0.0;
         let max_pen = m.max_penetration;
@@ -745,6 +749,7 @@ impl Ltca {
             pins.push(row);
             loaded.push(count);
             rot.push(th - kin[dk + 2]);
+            angles.push(th);
             disp.push([x[dk] - kin[dk], x[dk + 1] - kin[dk + 1]]);
         }
         // The line law's location term acts on the discs too (its reaction on the pins).
@@ -767,6 +772,7 @@ impl Ltca {
             pins,
             loaded_pins: loaded,
             disc_rotation: rot,
+            disc_angle: angles,
             disc_displacement: disp,
             mesh_force: cs.mesh_force.clone(),
             crank_bearing_force: cs.crank_bearing_force.clone(),
