@@ -12,7 +12,7 @@ import pytest
 
 import rvdyn
 from rvdyn import Scene, simulate
-from rvdyn.analysis import ltca, torque_twist, transmission_error
+from rvdyn.analysis import ARCSEC, ltca, torque_twist, transmission_error
 
 RATED = 43_921.3
 INPUT_SPEED = math.radians(8328.0)
@@ -166,6 +166,17 @@ def test_fea_loads_balance_the_bearing_forces_in_the_disc_frame() -> None:
         rotated = np.array([c * fb[0] + s * fb[1], -s * fb[0] + c * fb[1]])
         assert np.linalg.norm(pins + rotated) < 0.01 * a["pin_force"][i, k].max()
         assert np.linalg.norm(pins + fb) > 0.1 * a["pin_force"][i, k].max()  # the frames differ
+
+
+def test_a_torque_below_the_force_round_off_is_refused() -> None:
+    # At 1e-7 N m the load scale was below the round-off floor of the contact forces and Newton
+    # accepted the kinematic pose (TE 0, residual "6.7e-7" that was in newtons): now an error
+    # naming the smallest torque; 1e-3 N m takes up the clearances (-22.3 arcsec).
+    scene = Scene.physical("rated")
+    with pytest.raises(rvdyn.ParameterError, match="too small to resolve"):
+        ltca(scene, 1e-7, [0.0])
+    assert ltca(scene, 1e-3, [0.0]).arrays["transmission_error"][0] / ARCSEC == pytest.approx(-22.33, abs=0.05)
+    assert ltca(scene, 0.0, [0.0]).arrays["transmission_error"][0] == 0.0
 
 
 def test_pressures_beyond_the_elastic_limit_warn() -> None:

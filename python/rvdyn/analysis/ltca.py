@@ -494,7 +494,7 @@ def _excitation(sc: Scene) -> tuple[tuple[float, str], ...]:
 def transmission_error(scene: Scene, torque: float | None = None, points: int | None = None, *,
                        light: float | None = None, start: float = 0.0, window: bool = True) -> TransmissionError:
     """TE at ``points`` crank angles per mesh period, at ``+-torque`` and at the light load
-    ``+-light`` [N m] (default ``1e-6 torque``) from crank angle ``start`` [rad], over the
+    ``+-light`` [N m] (default ``1e-6 torque``, at least 1e-3 N m) from crank angle ``start`` [rad], over the
     ``window`` after which the whole TE repeats (``window=False``: one mesh period). By
     default ``points`` is 90, or eight per tooth-mesh cycle of an ISO 6336 mesh if that is
     more (``4 tooth_mesh_angles(scene)``: 336 on the physical preset, whose TE ripples 42
@@ -515,7 +515,9 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
     needed = _tooth_mesh_angles(sc, period)
     points = max(90, 4 * needed) if points is None else _whole("points", points, 2, MAX_POINTS)
     t = abs(_rated(sc, torque))
-    lt = 1e-6 * t if light is None else abs(_float("light", light, "N m"))
+    # The light load: 1e-6 of the torque, but not below 1e-3 N m (the torque-twist loop's zero
+    # points), where a floating body settles reliably above the forces' round-off.
+    lt = max(1e-6 * t, min(1e-3, 0.01 * t)) if light is None else abs(_float("light", light, "N m"))
     periods = _window_periods(float(solver.te_window), period) if window else 1
     d = solver.transmission_error(t, lt, int(points), _float("start", start, "rad"), False, periods)
     te = TransmissionError(crank_angle=d["crank_angle"], period=float(d["period"]),

@@ -278,6 +278,10 @@ fn lu_solve(m: &mut [f64], n: usize, b: &mut [f64], amax: f64) -> bool {
 /// `16 eps rp`.
 pub(crate) const STEP_ROUND_OFF: f64 = 16.0;
 
+/// The smallest load scale `|T| / rp` an equilibrium resolves, in multiples of the round-off
+/// floor of the contact forces (three significant digits of force).
+const MIN_LOAD_OVER_FLOOR: f64 = 1e3;
+
 /// Options of the equilibrium solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonOptions {
@@ -403,6 +407,17 @@ pub fn equilibrium(
         .zip(&scratch.scale)
         .fold(rp, |m, (x, l)| m.max((x * l).abs()));
     let floor = 4.0 * f64::EPSILON * k_ref * size;
+    // A load within a thousand times the round-off floor cannot be resolved: Newton would
+    // accept the kinematic pose as converged (1e-7 N m on the physical preset returned TE 0
+    // instead of the clearances' take-up).
+    if load > 0.0 && load < MIN_LOAD_OVER_FLOOR * floor {
+        return Err(RvdynError::Parameter(format!(
+            "the torque {torque:.3e} N m is too small to resolve: its load scale |T|/rp = \
+             {load:.3e} N is within {MIN_LOAD_OVER_FLOOR} times the round-off of the contact \
+             forces ({floor:.3e} N); use at least {:.3e} N m (or 0 for the unloaded pose)",
+            MIN_LOAD_OVER_FLOOR * floor * rp
+        )));
+    }
     let done = (opts.tolerance * load).max(floor);
     let stalled_ok = (1e-9 * load).max(10.0 * floor);
     let report_scale = load.max(1.0);
