@@ -154,7 +154,10 @@ class Mapper:
 
         out: list[Any] = [None] * len(items)
         pending = list(range(len(items)))
-        for attempt in range(2):
+        # Up to three rounds: a task cancelled because the shared task was lost, or finished
+        # on a worker that died before its result was fetched, runs again; a task whose own
+        # retries ran out (KilledWorker: it kills its worker) does not.
+        for attempt in range(3):
             # The second round sends the shared task with each item: a worker that dies then takes
             # only its own task along, not the copies every other task depends on.
             futures = self._submit(fn, [items[i] for i in pending], inline=attempt > 0)
@@ -180,7 +183,7 @@ class Mapper:
                         continue
                     except Exception:  # noqa: BLE001 - lost with its worker: as a cancelled one
                         pass
-                if f.status in ("cancelled", "lost", "pending", "finished") and attempt == 0:
+                if f.status != "error" and attempt < 2:
                     # Its input was lost with the workers that held it (a worker that died took
                     # the shared task's copies along): once more.
                     again.append(i)
