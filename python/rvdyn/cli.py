@@ -429,6 +429,12 @@ def _run_study(args: argparse.Namespace) -> int:
     y = res.get("yield")
     print(f"rvdyn study: {res['samples']} samples, {res['failed']} failed"
           + (f"; yield {y['rate']['value']:.4g} [{y['rate']['low']:.4g}, {y['rate']['high']:.4g}]" if y else ""))
+    if res["samples"] and res["failed"] == res["samples"]:
+        # Nothing to analyse: a wrong kernel option fails every sample, and a job script
+        # should see it.
+        print("rvdyn study: every sample failed; the first error is in the table's 'error' column",
+              file=sys.stderr)
+        return 1
     return 0
 
 

@@ -4,7 +4,8 @@ Format (SI units; every table but ``tolerances`` optional)::
 
     [scene]
     preset = "rated"                 # rvdyn.Scene.paper(preset), or: file = "scene.toml"
-    changes = { initial = "steady" } # dotted paths -> values, applied to the scene
+    changes = { initial = "steady" } # dotted paths -> values, applied to the scene (a nested
+                                     # table such as friction.pin = 0.1 changes that field only)
 
     [kernel]
     name = "dynamic"                 # or "ltca" (options torque, points, ...)
@@ -44,9 +45,12 @@ Relative file paths are relative to the spec file.
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from ..errors import ParameterError, SceneError
 from ..scene import Scene
@@ -105,9 +109,32 @@ def _runner(d: dict[str, Any]) -> Any:
     raise ParameterError(f"[runner] kind must be 'threads', 'processes', 'dask' or 'ray', got {kind!r}")
 
 
+def _dotted(changes: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """``changes`` as dotted paths to values. TOML reads ``{ friction.pin = 0.1 }`` as the
+    nested ``{friction: {pin: 0.1}}``, which as a whole table would reset the table's other
+    fields; nested tables are therefore opened down to their values, except a table with a
+    ``kind`` (a variant such as ``load`` or ``drive``), which replaces the field whole."""
+    out: dict[str, Any] = {}
+    for key, value in changes.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, dict) and "kind" not in value and value:
+            out.update(_dotted(value, path + "."))
+        else:
+            out[path] = value
+    return out
+
+
 def load_spec(path: str | Path) -> dict[str, Any]:
     """Read and check a study spec; returns the arguments of :func:`rvdyn.study.run` plus
-    ``"output"`` (folder), ``"criteria"``."""
+    ``"output"`` (folder), ``"criteria"``. A value of the wrong type anywhere in the spec is a
+    :class:`rvdyn.ParameterError` naming the spec."""
+    try:
+        return _load_spec(path)
+    except (TypeError, ValueError, KeyError) as exc:
+        raise ParameterError(f"study spec {str(path)!r}: {type(exc).__name__}: {exc}") from None
+
+
+def _load_spec(path: str | Path) -> dict[str, Any]:
     from .sampling import LatinHypercube, MonteCarlo
 
     p = Path(path)
@@ -125,10 +152,11 @@ def load_spec(path: str | Path) -> dict[str, Any]:
         except (SceneError, ValueError) as exc:
             raise ParameterError(f"[scene] preset: {exc}") from None
     if sc.get("changes"):
-        scene = scene.replace(**_keys("scene.changes", sc["changes"], set(sc["changes"])))
-    kern = dict(spec.get("kernel", {"name": "dynamic"}))
+        scene = scene.replace(**_dotted(_keys("scene.changes", sc["changes"], set(sc["changes"]))))
+    kern = spec.get("kernel", {"name": "dynamic"})
     if not isinstance(kern, dict):
-        raise ParameterError("[kernel] must be a table")
+        raise ParameterError(f"[kernel] must be a table (e.g. [kernel] name = \"ltca\"), got {kern!r}")
+    kern = dict(kern)
     kname = kern.pop("name", "dynamic")
     samp = _keys("sampling", spec.get("sampling", {}), {"method", "samples", "seed"})
     method = samp.get("method", "lhs")
@@ -190,13 +218,28 @@ def run_spec(path: str | Path, out: str | Path | None = None, samples: int | Non
             s = stats.src(table, m)
         except ParameterError as exc:
             result["sensitivity"][m] = {"error": str(exc)}
+            if plots:
+                _plots(table, m, None, args["criteria"], outdir)  # the histogram all the same
             continue
         result["sensitivity"][m] = {"method": "standardised regression coefficients", "r2": s.r2,
                                     "ranking": [[n, v] for n, v in zip(s.names, s.values)]}
         if plots:
             _plots(table, m, s, args["criteria"], outdir)
-    (outdir / "statistics.json").write_text(json.dumps(result, indent=1, default=float), encoding="utf-8")
+    # Strict JSON: a statistic that is not finite (a constant metric's R^2) is null.
+    (outdir / "statistics.json").write_text(json.dumps(_finite_or_null(result), indent=1, default=float,
+                                                       allow_nan=False), encoding="utf-8")
     return result
+
+
+def _finite_or_null(v: Any) -> Any:
+    """``v`` with every float that is not finite replaced by None (JSON has no NaN)."""
+    if isinstance(v, dict):
+        return {k: _finite_or_null(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_finite_or_null(x) for x in v]
+    if isinstance(v, (float, np.floating)):
+        return float(v) if math.isfinite(v) else None
+    return v
 
 
 def _plots(table: Any, metric: str, sens: Any, criteria: Any, outdir: Path) -> None:
@@ -208,6 +251,13 @@ def _plots(table: Any, metric: str, sens: Any, criteria: Any, outdir: Path) -> N
 
     from .plots import plot_histogram, plot_sensitivity
 
+    if sens is None:
+        fig, ax = plt.subplots(figsize=(6.5, 4.5))
+        plot_histogram(table, metric, criteria, ax=ax)
+        fig.tight_layout()
+        fig.savefig(outdir / f"{metric}.png", dpi=110)
+        plt.close(fig)
+        return
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
     plot_histogram(table, metric, criteria, ax=axes[0])
     plot_sensitivity(sens, ax=axes[1])

@@ -37,6 +37,10 @@ DYNAMIC_METRICS: dict[str, str] = {
 }
 
 
+#: Sample spacing of the dynamic kernel's runs [s] (``simulate``'s default).
+RECORD_INTERVAL: float = 1e-4
+
+
 @dataclass(frozen=True)
 class DynamicKernel:
     """A dynamic run of ``t_end`` [s] reduced to :data:`DYNAMIC_METRICS`.
@@ -56,6 +60,17 @@ class DynamicKernel:
             raise ParameterError(f"dynamic kernel: t_end must be a finite time > 0 [s], got {self.t_end!r}")
         if self.t_start is not None and not (math.isfinite(self.t_start) and 0 <= self.t_start < self.t_end):
             raise ParameterError(f"dynamic kernel: t_start must lie in [0, t_end), got {self.t_start!r}")
+        # The run's options are checked here, once, rather than failing every sample.
+        from ..simulation import Options
+
+        try:
+            Options(self.integrator, dt=self.dt)
+        except ParameterError as exc:
+            raise ParameterError(f"dynamic kernel: {exc}") from None
+        if self.t_end < 10 * RECORD_INTERVAL:
+            raise ParameterError(f"dynamic kernel: t_end = {self.t_end!r} s records fewer than 10 samples "
+                                 f"(every {RECORD_INTERVAL:g} s); the metrics need a run of at least "
+                                 f"{10 * RECORD_INTERVAL:g} s")
 
     @property
     def metrics(self) -> tuple[str, ...]:
@@ -65,7 +80,7 @@ class DynamicKernel:
         from ..simulation import simulate
 
         res = simulate(scene, self.t_end, self.integrator, dt=self.dt, channels=["motion", "pins", "mesh"],
-                       progress=False)
+                       record_interval=RECORD_INTERVAL, progress=False)
         t = res.t
         t0 = 0.2 * self.t_end if self.t_start is None else self.t_start
         i0 = min(int(np.searchsorted(t, t0)), len(t) - 2)

@@ -125,8 +125,14 @@ class Criterion:
         if self.max is None and self.min is None:
             raise ParameterError(f"criterion on {self.metric!r}: give max and/or min")
         for what, v in (("max", self.max), ("min", self.min)):
-            if v is not None and not math.isfinite(float(v)):
-                raise ParameterError(f"criterion on {self.metric!r}: {what} must be finite, got {v}")
+            if v is None:
+                continue
+            try:
+                x = float(v)
+            except (TypeError, ValueError):
+                raise ParameterError(f"criterion on {self.metric!r}: {what} must be a number, got {v!r}") from None
+            if isinstance(v, bool) or not math.isfinite(x):
+                raise ParameterError(f"criterion on {self.metric!r}: {what} must be finite, got {v!r}")
         if self.max is not None and self.min is not None and float(self.min) > float(self.max):
             raise ParameterError(
                 f"criterion on {self.metric!r}: min {self.min} is above max {self.max}, so no value passes")

@@ -229,9 +229,12 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
           confidence: float | None = 0.95, n_resamples: int = 999) -> Sensitivity:
     """First-order Sobol indices of ``metric`` (ranked; ``total`` holds the total indices in
     the same order) from a Saltelli design of ``n`` base samples (a power of 2): the kernel
-    runs n (d + 2) times on ``runner``. ``intervals`` holds percentile-bootstrap confidence
-    intervals at level ``confidence`` (None: none) from ``n_resamples`` resamples. Independent
-    tolerances only; a failed sample makes the estimate NaN (and leaves out the intervals)."""
+    runs n (d + 2) times on ``runner``. ``intervals`` holds bootstrap confidence intervals at
+    level ``confidence`` (None: none) from ``n_resamples`` resamples (SciPy's BCa bootstrap of
+    the Saltelli design; ``seed`` fixes the design and the indices, while SciPy draws the
+    bootstrap resamples unseeded, so the interval ends vary by about 1/sqrt(n_resamples)). Independent tolerances only; a failed
+    sample (or a metric the kernel does not give) makes every index NaN and leaves out the
+    intervals: SciPy would read the NaN outputs as 0 and report no sensitivity at all."""
     from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     from .kernels import get_kernel
@@ -258,6 +261,8 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
     task = Task(scene, k, layout, 1, os.getpid())
     fn = functools.partial(evaluate_batch, task)
 
+    failed = [0]
+
     def func(xs: np.ndarray) -> np.ndarray:
         full = np.tile(nominal[:, None], (1, xs.shape[1]))
         full[keep] = xs
@@ -269,6 +274,7 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
             if not isinstance(res, _Failure):
                 for sid, m, _ in res:
                     out[sid] = m.get(metric, np.nan)
+        failed[0] += int(np.count_nonzero(~np.isfinite(out)))
         return out[None, :]
 
     try:
@@ -277,11 +283,15 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
         mapper.close()
     first = np.asarray(res.first_order).ravel()
     total = np.asarray(res.total_order).ravel()
+    if failed[0]:
+        first = np.full(first.shape, np.nan)
+        total = np.full(total.shape, np.nan)
     names = [layout.variables[j].column for j in keep]
     order = np.argsort(-np.abs(first), kind="stable")
     intervals: tuple[tuple[float, float, float, float], ...] = ()
     if confidence is not None and np.all(np.isfinite(first)) and np.all(np.isfinite(total)):
-        # Percentile bootstrap over the Saltelli design's rows (SciPy's SobolResult.bootstrap).
+        # SciPy's SobolResult.bootstrap (BCa over the Saltelli design's rows); it takes no
+        # generator, so its resamples (not the indices) change from call to call.
         boot = res.bootstrap(confidence_level=confidence, n_resamples=n_resamples)
         f_ci = boot.first_order.confidence_interval
         t_ci = boot.total_order.confidence_interval

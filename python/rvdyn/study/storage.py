@@ -4,7 +4,7 @@ Columns: ``sample`` (int64 id, 0..n-1), one float64 column per toleranced variab
 the scene got, field units), one float64 column per metric (NaN for a failed sample) and
 ``error`` (the failure message, "" for a sample that ran).
 
-On disk (``out="study.parquet"``) the table is a folder: ``meta.json`` (what the study is,
+On disk (``out="study.parquet"``) the table is a folder: ``_meta.json`` (what the study is,
 checked on resume) and ``part-<seq>.parquet`` files, one per chunk, each written to a temporary
 name then renamed, so a crash never leaves a partial part. Pandas and pyarrow read the folder
 as one table (``pandas.read_parquet(path)``); :func:`read` sorts it by sample id, keeping the
@@ -24,7 +24,9 @@ from ..errors import ParameterError
 
 __all__ = ["MemoryStore", "ParquetStore", "open_store", "read", "to_table", "have_pandas"]
 
-META = "meta.json"
+# The leading underscore keeps pandas and pyarrow, which skip such files, from reading it as
+# a part of the table.
+META = "_meta.json"
 
 
 def have_pandas() -> bool:
@@ -213,5 +215,5 @@ def read(path: str | Path, as_numpy: bool = False) -> Any:
 
 
 def read_meta(path: str | Path) -> dict[str, Any]:
-    """The ``meta.json`` of a study folder."""
+    """The ``_meta.json`` of a study folder."""
     return dict(json.loads((Path(path) / META).read_text(encoding="utf-8")))
