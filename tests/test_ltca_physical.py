@@ -168,6 +168,15 @@ def test_fea_loads_balance_the_bearing_forces_in_the_disc_frame() -> None:
         assert np.linalg.norm(pins + fb) > 0.1 * a["pin_force"][i, k].max()  # the frames differ
 
 
+def test_harmonics_warn_when_the_grid_cannot_read_the_sun_mesh() -> None:
+    # At two angles per tooth-mesh cycle (tooth_mesh_angles, 84) the sun-mesh fundamental sits
+    # on the Nyquist bin and read 0.033 of its 0.96 arcsec, silently.
+    scene = Scene.physical("rated")
+    te = transmission_error(scene, RATED, rvdyn.analysis.tooth_mesh_angles(scene), window=False)
+    with pytest.warns(RuntimeWarning, match="sun mesh fundamental"):
+        te.harmonics("forward", 3)
+
+
 def test_a_torque_below_the_force_round_off_is_refused() -> None:
     # At 1e-7 N m the load scale was below the round-off floor of the contact forces and Newton
     # accepted the kinematic pose (TE 0, residual "6.7e-7" that was in newtons): now an error

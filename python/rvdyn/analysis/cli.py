@@ -112,10 +112,13 @@ def run(args: argparse.Namespace) -> int:
         f"the +-rated points, lost motion within +-3 % of it)",
         f"- equilibrium: torque balance <= {summary['torque_balance_max']:.1e}, residual <= "
         f"{summary['residual_max']:.1e} (relative)",
+        *([f"- friction (pins {fr['pin']:g}, teeth {fr['mesh']:g}): in the torque-twist loop only; the "
+           "load distribution, TE and input torque above are frictionless"] if (fr := scene.to_dict()["friction"])
+          and (fr["pin"] > 0 or fr["mesh"] > 0 or fr.get("bearing")) else []),
         "",
         "Conventions and formulas: docs/model.md, \"Quasi-static analysis\".",
         "",
     ]
     (out / "summary.md").write_text("\n".join(md))
-    print("\n".join(md[2:8]))
+    print("\n".join(line for line in md if line.startswith("- ")))
     return 0

@@ -236,6 +236,9 @@ class TransmissionError:
         endpoint excluded (periodic when they cover the ``window``): ``X_k = (1/N) sum_j TE_j exp(-2 pi i j k / N)``, amplitude ``2 |X_k|``
         (``|X_k|`` at ``k = N/2``) and phase ``arg X_k``, for ``1 <= k <= N/2``; exact for a
         curve with no harmonics above ``N/2`` (docs/model.md, "Transmission error harmonics").
+        ``harmonic`` counts cycles over the whole span (``periods`` mesh periods), not per
+        period. A ``RuntimeWarning`` says when the pin-pass or sun-mesh fundamental lies at or
+        beyond ``N/2``.
         Harmonics above ``N/2`` fold onto lower ones: refine ``points`` until the amplitudes
         you read stop changing. The order of harmonic k is ``k / input_turns`` per input
         revolution; a harmonic within 1e-9 of an excitation order of the scene (pin pass, sun
@@ -259,6 +262,16 @@ class TransmissionError:
         amp = 2.0 * np.abs(x[1:])
         if n % 2 == 0:
             amp[-1] *= 0.5  # the Nyquist bin has no mirror
+        # An excitation at or above the Nyquist bin cannot be read from these samples (at two
+        # angles per tooth-mesh cycle the sun mesh falls on it and read 0.03 of its 0.96 arcsec).
+        lost = {lab: oo * self.input_turns for oo, lab in self.excitation
+                if lab in ("sun mesh", "pin pass") and oo * self.input_turns >= n / 2 - 1e-9}
+        if lost:
+            need = math.floor(2 * max(lost.values()) / self.periods) + 1
+            warnings.warn(
+                f"TransmissionError.harmonics: {n} samples resolve harmonics below {n // 2} over the "
+                f"span; the {' and '.join(lost)} fundamental lies at or beyond it and is not read "
+                f"correctly: use at least {need} points per period", RuntimeWarning, stacklevel=2)
         order = np.argsort(-amp, kind="stable")[: int(count)]
         out = []
         for i in order:
@@ -408,6 +421,9 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
 
     ``tolerance``: Newton's residual target, a fraction of the load scale (``|T| / rp``), in
     (0, 1e-6]; the balance of every body closes to 1e-9 at the default 1e-12.
+
+    The equilibria are frictionless whatever the scene's ``friction``: friction enters
+    :func:`torque_twist` (by default) and :func:`running_friction`.
 
     Raises ``ConvergenceError`` (naming the crank angle and residual) when no equilibrium is
     found, ``ParameterError`` for non-finite input or a tolerance outside its range.

@@ -723,9 +723,11 @@ fn stick(held: Option<f64>, direction: f64, slide: f64) -> f64 {
     }
 }
 
-/// The loop's torques `0 -> +rated -> -rated -> 0` (piecewise linear in the point index) and
-/// `|rated|`. Errors (`Parameter`) for a non-finite or zero rated torque or fewer than 8
-/// points.
+/// The loop's torques `0 -> +rated -> 0 -> -rated -> 0`, linear in the point index within each
+/// quarter, with `points - 1` steps shared among the quarters as evenly as whole numbers allow
+/// (so that `+-rated` and the zeros are always points: with 10 points the tip used to be 0.89
+/// rated), and `|rated|`. Errors (`Parameter`) for a non-finite or zero rated torque or fewer
+/// than 8 points.
 pub(crate) fn loop_torques(rated: f64, points: usize) -> Result<(Vec<f64>, f64)> {
     crate::error::require_finite("rated torque", rated)?;
     let rated = rated.abs();
@@ -736,19 +738,18 @@ pub(crate) fn loop_torques(rated: f64, points: usize) -> Result<(Vec<f64>, f64)>
              {rated} N m and {points}"
         )));
     }
-    let torque = (0..points)
-        .map(|i| {
-            let s = 4.0 * i as f64 / (points - 1) as f64;
-            let v = if s <= 1.0 {
-                s
-            } else if s <= 3.0 {
-                2.0 - s
-            } else {
-                s - 4.0
-            };
-            rated * v
-        })
-        .collect();
+    let steps = points - 1;
+    let mut torque = Vec::with_capacity(points);
+    torque.push(0.0);
+    for (k, (a, b)) in [(0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0)]
+        .into_iter()
+        .enumerate()
+    {
+        let q = steps / 4 + usize::from(k < steps % 4);
+        for j in 1..=q {
+            torque.push(rated * (a + (b - a) * j as f64 / q as f64));
+        }
+    }
     Ok((torque, rated))
 }
 

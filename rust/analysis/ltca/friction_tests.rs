@@ -246,3 +246,18 @@ fn running_efficiency_is_the_power_balance_of_the_sliding() {
     }
     assert!((etas[0] - etas[1]).abs() < 1e-9, "{etas:?}");
 }
+
+#[test]
+fn the_loop_passes_through_its_tips_at_any_point_count() {
+    // With 10 points the tip used to be 0.89 rated (the steps were equal over the whole loop).
+    for points in 8..60 {
+        let (t, rated) = super::loop_torques(-2.0, points).unwrap();
+        assert_eq!((t.len(), rated), (points, 2.0));
+        assert_eq!((t[0], t[points - 1]), (0.0, 0.0));
+        assert!(t.contains(&2.0) && t.contains(&-2.0), "{points}: {t:?}");
+        assert_eq!(t.iter().filter(|v| **v == 0.0).count(), 3, "{points}");
+    }
+    // 4k + 1 points: the equal steps of before.
+    let (t, _) = super::loop_torques(1.0, 9).unwrap();
+    assert_eq!(t, [0.0, 0.5, 1.0, 0.5, 0.0, -0.5, -1.0, -0.5, 0.0]);
+}
