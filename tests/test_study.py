@@ -457,6 +457,19 @@ def test_spec_mistakes_are_one_line_errors_and_dotted_changes_change_one_field(t
     assert main(["study", spec('[kernel]\nname = "dynamic"\nt_end = 0.01\nintegrator = "bogus"')]) == 1
 
 
+def scene_named_metrics(scene: rvdyn.Scene) -> dict[str, float]:
+    """Metrics named like scene paths ("force.max" is dotted, "density" a scene field)."""
+    return {"force.max": 3.0 * scene["cycloid.d_rrp"] / 1e-5, "density": 7850.0 + scene["cycloid.d_rp"] / 1e-5}
+
+
+def test_numpy_tables_keep_their_column_roles() -> None:
+    # A structured array told inputs from metrics by name: these metrics were taken for inputs.
+    a = rvdyn.study(SCENE, scene_named_metrics, TOLS, samples=20, seed=2, as_numpy=True)
+    assert rvdyn.study.stats.input_names(a) == ["cycloid.d_rrp", "cycloid.d_rp"]
+    assert rvdyn.study.stats.metric_names(a) == ["force.max", "density"]
+    assert rvdyn.study.src(a, "force.max").names[0] == "cycloid.d_rrp"
+
+
 def test_statistics_of_a_numpy_table_match_the_dataframe() -> None:
     a = rvdyn.study(SCENE, linear_metric, TOLS, samples=40, seed=2, as_numpy=True)
     df = rvdyn.study(SCENE, linear_metric, TOLS, samples=40, seed=2)

@@ -417,7 +417,8 @@ def _run_analyze(args: argparse.Namespace) -> int:
 
 def _add_study(p: argparse.ArgumentParser) -> None:
     p.add_argument("spec", metavar="SPEC.toml", help="study spec (format: help(rvdyn.study.config))")
-    p.add_argument("--out", default=None, metavar="DIR", help="output folder (default: the spec's [output] dir)")
+    p.add_argument("--out", default=None, metavar="DIR", type=_folder,
+                   help="output folder (default: the spec's [output] dir)")
     p.add_argument("--samples", type=int, default=None, metavar="N", help="override the number of samples")
     p.add_argument("--no-plots", action="store_true", help="do not draw the figures")
 

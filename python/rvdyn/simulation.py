@@ -149,7 +149,9 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
 
 def _grid(base: Scene, grid: Mapping[str, Iterable[Any]]) -> tuple[list[Scene], list[dict[str, Any]]]:
     keys = list(grid)
-    values = [list(grid[k]) for k in keys]
+    # numpy scalars (a grid from np.array or np.linspace) as Python numbers: each run's
+    # options["point"] must be JSON.
+    values = [[v.item() if hasattr(v, "item") and callable(v.item) else v for v in grid[k]] for k in keys]
     scenes, points = [], []
     for combo in itertools.product(*values):
         point = dict(zip(keys, combo))

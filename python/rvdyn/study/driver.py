@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import math
 import os
 import sys
 import time
@@ -80,6 +81,9 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
     threads_per_worker = _positive("threads_per_worker", threads_per_worker)
     if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
         raise ParameterError(f"retries must be an integer >= 0, got {retries!r}")
+    if isinstance(connect_timeout, bool) or not (isinstance(connect_timeout, (int, float))
+                                                 and math.isfinite(connect_timeout) and connect_timeout > 0):
+        raise ParameterError(f"connect_timeout must be a time > 0 s, got {connect_timeout!r}")
     k = get_kernel(kernel, **(kernel_options or {}))
     layout = expand(scene, tolerances, correlations)
     metrics = getattr(k, "metrics", None)

@@ -58,11 +58,15 @@ def _is_input(name: str) -> bool:
 
 
 def input_names(table: Any) -> list[str]:
-    """Names of the toleranced input columns (``table.attrs["inputs"]`` of a DataFrame, else
-    the columns named by a scene path)."""
+    """Names of the toleranced input columns (``table.attrs["inputs"]`` of a DataFrame or
+    ``dtype.metadata["inputs"]`` of a structured array, else the columns named by a scene
+    path)."""
     attrs = getattr(table, "attrs", None)
     if isinstance(attrs, dict) and "inputs" in attrs:
         return list(attrs["inputs"])
+    meta = getattr(getattr(table, "dtype", None), "metadata", None)  # a read-only mapping
+    if meta is not None and "inputs" in meta:
+        return list(meta["inputs"])
     return [c for c in columns(table) if c not in _RESERVED and _is_input(c)]
 
 
@@ -71,6 +75,9 @@ def metric_names(table: Any) -> list[str]:
     attrs = getattr(table, "attrs", None)
     if isinstance(attrs, dict) and "metrics" in attrs:
         return list(attrs["metrics"])
+    meta = getattr(getattr(table, "dtype", None), "metadata", None)
+    if meta is not None and "metrics" in meta:
+        return list(meta["metrics"])
     return [c for c in columns(table) if c not in _RESERVED and not _is_input(c)]
 
 
@@ -247,6 +254,8 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
         raise ParameterError(f"sobol: n must be a power of 2 >= 2, got {n!r}")
     if confidence is not None and not 0 < confidence < 1:
         raise ParameterError(f"sobol: confidence must lie in (0, 1) or be None, got {confidence!r}")
+    if isinstance(batch_size, bool) or not isinstance(batch_size, (int, np.integer)) or batch_size < 1:
+        raise ParameterError(f"sobol: batch_size must be a positive integer, got {batch_size!r}")
     k = get_kernel(kernel, **(kernel_options or {}))
     layout = expand(scene, tolerances)
     metrics = getattr(k, "metrics", None)

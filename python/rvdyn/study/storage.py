@@ -172,7 +172,8 @@ def _concat(parts: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
 def to_table(cols: dict[str, np.ndarray], as_numpy: bool = False, inputs: Sequence[str] | None = None,
              metrics: Sequence[str] | None = None) -> Any:
     """A pandas DataFrame (when pandas is installed and not ``as_numpy``; ``attrs`` holds the
-    ``inputs`` and ``metrics`` column names) or a numpy structured array, columns in order."""
+    ``inputs`` and ``metrics`` column names) or a numpy structured array, columns in order, whose
+    ``dtype.metadata`` holds the same names."""
     if not as_numpy and have_pandas():
         import pandas as pd  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
@@ -184,8 +185,13 @@ def to_table(cols: dict[str, np.ndarray], as_numpy: bool = False, inputs: Sequen
         return df
     n = len(cols["sample"])
     width = max([len(str(e)) for e in cols.get("error", [])] + [1])
-    dtype = [(k, np.int64 if k == "sample" else (f"U{width}" if k == "error" else np.float64)) for k in cols]
-    arr = np.zeros(n, dtype=dtype)
+    fields = [(k, np.int64 if k == "sample" else (f"U{width}" if k == "error" else np.float64)) for k in cols]
+    # The column roles travel with the array (a metric named like a scene path, e.g. "density",
+    # was otherwise taken for an input).
+    meta = {k: list(v) for k, v in (("inputs", inputs), ("metrics", metrics)) if v is not None}
+    if "metrics" in meta:
+        meta["metrics"] = [m for m in meta["metrics"] if m in cols]
+    arr = np.zeros(n, dtype=np.dtype(fields, metadata=meta) if meta else np.dtype(fields))
     for k, v in cols.items():
         arr[k] = v.astype(str) if k == "error" else v
     return arr
