@@ -324,7 +324,9 @@ def _paper_t_end(text: str) -> float:
         t = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"not a number of seconds: {text!r}") from None
-    if not (math.isfinite(t) and t >= PAPER_MIN_T_END):
+    if not math.isfinite(t):
+        raise argparse.ArgumentTypeError(f"must be a finite time in s, got {text}")
+    if t < PAPER_MIN_T_END:
         raise argparse.ArgumentTypeError(
             f"must be at least {PAPER_MIN_T_END} s (the summary averages whole crank "
             f"revolutions after the first 20 % of the run), got {text}"

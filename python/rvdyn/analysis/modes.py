@@ -370,6 +370,9 @@ def run_cli(args: Any) -> int:
     os.makedirs(args.out, exist_ok=True)
     m = modes(scene, args.torque, args.crank_angle)
     sweep = modes_over_mesh(scene, m.torque, points=25, start=args.crank_angle)
+    if args.speeds is not None and not (np.all(np.isfinite(args.speeds)) and 0 < args.speeds[0] < args.speeds[1]):
+        raise ParameterError(f"--speeds LO HI must be finite input speeds in deg/s with 0 < LO < HI, "
+                             f"got {args.speeds[0]} {args.speeds[1]}")
     speeds = None if args.speeds is None else np.radians(np.linspace(args.speeds[0], args.speeds[1], args.points))
     cd = campbell(scene, speeds, power=args.power, torque=None if args.power is not None else m.torque,
                   crank_angle=args.crank_angle, harmonics=args.harmonics, points=args.points)
