@@ -46,8 +46,10 @@ pub fn worst_loads(points: &[LtcaPoint]) -> Result<Vec<FeaLoad>> {
             .iter()
             .max_by(|a, b| peak(a).total_cmp(&peak(b)))
             .unwrap_or(first);
+        // Round-off forces (1e-15 N at zero torque) are not loads.
+        let floor = super::LOADED_FRACTION * peak(worst).max(1.0);
         for (j, l) in worst.pins[k].iter().enumerate() {
-            if l.force > 0.0 {
+            if l.force > floor {
                 out.push(FeaLoad {
                     disc: k,
                     pin: j + 1,

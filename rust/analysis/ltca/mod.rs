@@ -292,6 +292,10 @@ pub const SWEEP_CHAIN: usize = 150;
 /// At most this many chains per sweep.
 const MAX_SWEEP_CHAINS: usize = 64;
 
+/// A pin is loaded above this fraction of the load scale `|T| / rp` (at least of 1 N): below
+/// it a force is round-off.
+pub const LOADED_FRACTION: f64 = 1e-9;
+
 /// The most crank angles or loop points one analysis takes: ten million solves take hours, and
 /// a count far beyond it (a typo) would otherwise abort on allocation instead of raising.
 pub const MAX_POINTS: usize = 10_000_000;
@@ -698,6 +702,9 @@ impl Ltca {
         };
         let mut pins = Vec::with_capacity(m.discs.len());
         let mut loaded = Vec::new();
+        // A pin counts as loaded above round-off: at zero torque the unmodified profile touches
+        // pins with forces of 1e-15 N, which were counted (and exported for FEA).
+        let loaded_above = LOADED_FRACTION * (torque.abs() / st.scale[0]).max(1.0);
         let mut rot = Vec::new();
         let mut angles = Vec::new();
         let mut disp = Vec::new();
@@ -731,7 +738,7 @@ impl Ltca {
                 } else {
                     (0.0, 0.0)
                 };
-                if f > 0.0 {
+                if f > loaded_above {
                     count += 1;
                 }
                 // Moment about the reducer axis of the pin's force -f N on the disc.
