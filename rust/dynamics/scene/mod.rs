@@ -855,7 +855,14 @@ impl Scene {
         for (path, value) in changes {
             set_path(&mut tree, path, value.clone())?;
         }
-        Self::from_value(&tree)
+        Self::from_value(&tree).map_err(|e| match e {
+            // The type errors of the deserialiser name no field: name the changed ones.
+            RvdynError::Scene(m) if m.starts_with("invalid scene:") => {
+                let paths: Vec<&str> = changes.iter().map(|(p, _)| p.as_str()).collect();
+                RvdynError::Scene(format!("{m} (in the change of {})", paths.join(", ")))
+            }
+            other => other,
+        })
     }
 
     /// Geometry parameters of disc `k` (scene values with the disc's own modifications).
