@@ -62,7 +62,10 @@ def test_channels_efficiency_and_bearing_life(physical_run):
     assert abs(eta - 0.917) < 0.02
     fp = r.friction_power_means(t_start=0.01)
     assert fp["pin"] > fp["mesh"] > 0.0 and fp["bearing"] == 0.0
-    life = r.bearing_life(t_start=0.01)
+    # 20 ms is a fifth of a crank revolution relative to the carrier: the life depends on the
+    # window, which is said.
+    with pytest.warns(RuntimeWarning, match="crank revolutions"):
+        life = r.bearing_life(t_start=0.01)
     for name in ("eccentric", "crank"):
         d = life[name]
         assert d["rating"] > 0 and d["equivalent_load"] > 0

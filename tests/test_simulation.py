@@ -192,6 +192,15 @@ def test_single_disc_scene_builds_only_one_disc() -> None:
     assert r.pin_force.shape[1:] == (1, 24)
 
 
+def test_a_mixed_sweep_gives_each_scene_its_own_defaults() -> None:
+    # A scene with roller bearings in the list used to switch every scene to dopri5: the
+    # paper scene's pin forces then differed from simulate's by 6 % of the peak.
+    runs = rvdyn.sweep([Scene.paper("rated"), Scene.physical("rated")], 0.005, channels=["pins"])
+    assert [r.options["integrator"] for r in runs] == ["generalized-alpha", "dopri5"]
+    alone = simulate(Scene.paper("rated"), 0.005, channels=["pins"])
+    np.testing.assert_array_equal(runs[0].pin_force, alone.pin_force)
+
+
 def test_sweep_runs_a_grid_and_reports_failures() -> None:
     base = Scene.paper("rated", initial="steady")
     out = rvdyn.sweep(base, 0.01, grid={"load.torque": [1e4, 2e4]}, channels=["pins"])

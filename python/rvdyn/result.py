@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 import zipfile
 from pathlib import Path
 from typing import Any, Generic, Iterable, TypeVar, overload
@@ -263,9 +264,13 @@ class Result:
     def bearing_life(self, t_start: float | None = None) -> dict[str, dict[str, float]]:
         """Peak and equivalent radial load [N], ISO 281 rating [N] and basic rating life
         ``L10`` [million revolutions and hours] of the most loaded eccentric and crank bearing,
-        from ``t_start`` [s] (default: the steady part). The equivalent load weights
-        ``|F|^(10/3)`` by the bearing's revolutions (relative rotation of its rings); the life
-        holds if the window repeats. Needs the ``"bearings"`` and ``"motion"`` channels and a
+        from ``t_start`` [s] to the end (default: :meth:`steady_window`, whole crank revolutions
+        relative to the carrier, over which every eccentric bearing sees its whole load cycle).
+        The equivalent load weights ``|F|^(10/3)`` by the bearing's revolutions (relative
+        rotation of its rings); the life holds if the window repeats. A window of less than one
+        such revolution gives a ``RuntimeWarning`` (an eccentric bearing's load swings by a factor
+        of about three over the revolution, so part of it over- or understates the life), and
+        one of fewer than two samples a ``ParameterError``. Needs the ``"bearings"`` and ``"motion"`` channels and a
         scene whose bearings are built from rollers (``rollers``): ``ParameterError`` if none is;
         a bearing family without rollers is left out."""
         c_ecc, c_crank = _core.CompiledScene.from_json(json.dumps(self.scene)).bearing_ratings()
@@ -275,8 +280,26 @@ class Result:
                 "give joints.eccentric_bearing.rollers (and joints.crank_bearing.rollers), as "
                 "Scene.physical does; the bearing forces are in eccentric_bearing_force and "
                 "crank_bearing_force")
-        i0 = int(np.searchsorted(self.t, self._steady_start(t_start)))
+        if t_start is None:
+            try:
+                t0 = self.steady_window()[0]
+            except ParameterError:
+                t0 = self._steady_start(None)
+        else:
+            t0 = self._steady_start(t_start)
+        i0 = int(np.searchsorted(self.t, t0))
         t = self.t[i0:]
+        if len(t) < 2:
+            raise ParameterError(f"the window from t_start = {t0:.6g} s holds {len(t)} sample(s): "
+                                 "start it earlier")
+        turns = abs(float(self.crank_angle[-1, 0] - self.carrier_angle[-1]
+                          - self.crank_angle[i0, 0] + self.carrier_angle[i0])) / (2 * math.pi)
+        if turns < 0.99:  # (steady_window starts between two samples)
+            warnings.warn(
+                f"bearing_life: the window from {t0:.4g} s holds {turns:.2f} crank revolutions relative "
+                "to the carrier; an eccentric bearing sees its whole load cycle only over whole ones "
+                "(steady_window): run longer for a life that does not depend on the window",
+                RuntimeWarning, stacklevel=2)
         duration = float(t[-1] - t[0])
         out: dict[str, dict[str, float]] = {}
         crank = self.crank_angle[i0:]

@@ -190,13 +190,20 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
             raise ParameterError("give either a list of scenes or one scene with a grid, not both")
         scene_list = [_check_scene(s) for s in scenes]
         points = [{} for _ in scene_list]
-    integrator, changes = _scene_defaults(scene_list, options, integrator, {
-        "dt": dt, "rtol": rtol, "atol": atol, "rho_inf": rho_inf, "record_interval": record_interval,
-        "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated,
-        "step_check": step_check, "h_min": h_min, "max_steps": max_steps})
-    opts = _resolve_options(options, integrator, changes)
+    given = {"dt": dt, "rtol": rtol, "atol": atol, "rho_inf": rho_inf, "record_interval": record_interval,
+             "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated,
+             "step_check": step_check, "h_min": h_min, "max_steps": max_steps}
     t = _t_end(t_end)
-    used = opts.resolved(t)
+    # Each scene gets the defaults simulate would give it: scenes with and without roller
+    # bearings run as two groups (one group's defaults used to apply to every scene).
+    groups: dict[bool, list[int]] = {}
+    for i, s in enumerate(scene_list):
+        groups.setdefault(_has_rollers(s), []).append(i)
+    plans = []
+    for idx in groups.values():
+        integ, changes = _scene_defaults([scene_list[i] for i in idx], options, integrator, given)
+        opts = _resolve_options(options, integ, changes)
+        plans.append((idx, opts, opts.resolved(t)))
     if threads is not None:
         try:
             if isinstance(threads, bool):
@@ -206,15 +213,17 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
             raise ParameterError(f"threads must be a whole number >= 1 (None = one per core), got {threads!r}") from None
         if threads < 1:
             raise ParameterError(f"threads must be a whole number >= 1 (None = one per core), got {threads!r}")
-    raw = _core.sweep([s._compiled for s in scene_list], t, opts, threads=threads)
-    out: list[Result] = []
-    for scene, point, item in zip(scene_list, points, raw):
-        run_options = {**used, "point": json.loads(json.dumps(point))}
-        if isinstance(item, BaseException):
-            error = item if isinstance(item, RvdynError) else RvdynError(str(item))
-            out.append(Result.failed(error, scene.to_dict(), run_options))
-        else:
-            arrays, stats = item
-            _warn(stats)
-            out.append(Result(arrays, stats, scene.to_dict(), run_options))
-    return out
+    results: list[Result | None] = [None] * len(scene_list)
+    for idx, opts, used in plans:
+        raw = _core.sweep([scene_list[i]._compiled for i in idx], t, opts, threads=threads)
+        for i, item in zip(idx, raw):
+            scene, point = scene_list[i], points[i]
+            run_options = {**used, "point": json.loads(json.dumps(point))}
+            if isinstance(item, BaseException):
+                error = item if isinstance(item, RvdynError) else RvdynError(str(item))
+                results[i] = Result.failed(error, scene.to_dict(), run_options)
+            else:
+                arrays, stats = item
+                _warn(stats)
+                results[i] = Result(arrays, stats, scene.to_dict(), run_options)
+    return [r for r in results if r is not None]
