@@ -37,6 +37,11 @@ def test_nonsense_is_a_scene_error_naming_the_field():
         Scene.physical("rated").replace(**{"joints.eccentric_bearing.rollers.count": 0})
     with pytest.raises(SceneError, match="clearance"):
         Scene.physical("rated").replace(**{"joints.crank_bearing.clearance": -1e-6})
+    # Friction no model applies was accepted and silently dropped.
+    with pytest.raises(SceneError, match="friction.bearing"):
+        Scene.paper("rated", friction={"bearing": {"f0": 4.0, "f1": 0.002, "viscosity": 1e-4}})
+    with pytest.raises(SceneError, match="friction.mesh"):
+        Scene.paper("rated", stage1=None, friction={"mesh": 0.1})
 
 
 def test_a_steady_start_with_a_ramped_drive_is_a_scene_error():

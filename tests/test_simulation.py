@@ -192,6 +192,15 @@ def test_single_disc_scene_builds_only_one_disc() -> None:
     assert r.pin_force.shape[1:] == (1, 24)
 
 
+def test_efficiency_of_a_back_driven_reducer_is_below_one() -> None:
+    # The load driving the input (negative load torque): output over input work gave 1.08.
+    rough = Scene.paper("rated", initial="steady", friction={"pin": 0.05, "mesh": 0.05})
+    kw: dict[str, Any] = {"channels": ["motion", "energy"], "progress": False}
+    forward = simulate(rough, 0.05, "dopri5", **kw).efficiency(0.02)
+    back = simulate(rough.replace(**{"load.torque": -43921.3}), 0.05, "dopri5", **kw).efficiency(0.02)
+    assert 0.85 < forward < 0.95 and 0.85 < back < 0.95
+
+
 def test_a_mixed_sweep_gives_each_scene_its_own_defaults() -> None:
     # A scene with roller bearings in the list used to switch every scene to dopri5: the
     # paper scene's pin forces then differed from simulate's by 6 % of the peak.

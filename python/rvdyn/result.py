@@ -246,14 +246,24 @@ class Result:
                 "residual": res, "relative_residual": abs(res) / scale if scale > 0 else 0.0}
 
     def efficiency(self, t_start: float | None = None) -> float:
-        """Efficiency output work / input work over the window from ``t_start`` [s] (default:
-        the steady part) to the end. Needs the ``"energy"`` channels."""
+        """Efficiency over the window from ``t_start`` [s] (default: 20 % of the run) to the
+        end: the work delivered over the work put in, output over input when the input drives
+        (``input_work`` > 0), input over output when the load drives the input (back-driving,
+        both works negative; before, that returned 1.08 for a reducer losing 8 %). Over whole
+        crank revolutions (:meth:`steady_window`) the mesh cycles' ripple cancels. Needs the
+        ``"energy"`` channels; ``ParameterError`` when no work flows or power flows out at both
+        ends."""
         i0 = int(np.searchsorted(self.t, self._steady_start(t_start)))
         w_in = float(self.input_work[-1] - self.input_work[i0])
         w_out = float(self.output_work[-1] - self.output_work[i0])
-        if w_in == 0.0:
-            raise ParameterError("no input work in the window: efficiency undefined")
-        return w_out / w_in
+        if w_in == 0.0 or w_out == 0.0:
+            raise ParameterError("no work flows through the reducer in the window: efficiency undefined")
+        if w_in > 0.0 and w_out > 0.0:
+            return w_out / w_in
+        if w_in < 0.0 and w_out < 0.0:
+            return w_in / w_out
+        raise ParameterError(f"the reducer takes work at both ends (input {w_in:.4g} J, output {w_out:.4g} J "
+                             "in the window, e.g. while it speeds up): efficiency undefined")
 
     def friction_power_means(self, t_start: float | None = None) -> dict[str, float]:
         """Mean friction power [W] per family (pins, teeth, bearings) from ``t_start`` [s]."""

@@ -248,15 +248,15 @@ pub static CHANNELS: &[ChannelSpec] = &[
         Some(Pins),
         &[Dim::Discs, Dim::Pins],
         "m",
-        "penetration of pin j into disc k",
+        "penetration of pin j into disc k (0 for a pin out of contact, whatever its gap)",
     ),
     spec(
         "pin_moment",
         Some(Pins),
         &[Dim::Discs, Dim::Pins],
         "N m",
-        "moment of pin j's force about disc k's centre (z component; about the ring centre it \
-         is zp/zc times larger)",
+        "moment of pin j's normal force (with its damping; not its friction) about disc k's \
+         centre (z component; about the ring centre it is zp/zc times larger)",
     ),
     ChannelSpec {
         name: "loaded_pins",
@@ -272,14 +272,15 @@ pub static CHANNELS: &[ChannelSpec] = &[
         Some(ContactPoints),
         &[Dim::Discs, Dim::Pins, Dim::Xy],
         "m",
-        "contact point on the profile, fixed frame",
+        "contact point on the profile, fixed frame ((0, 0) for a pin whose exact gap was not \
+         queried: out of contact and skipped)",
     ),
     spec(
         "pin_normal",
         Some(ContactPoints),
         &[Dim::Discs, Dim::Pins, Dim::Xy],
         "1",
-        "unit outward profile normal at the contact",
+        "unit outward profile normal at the contact ((0, 0) where the point is)",
     ),
     spec(
         "mesh_force",

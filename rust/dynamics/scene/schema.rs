@@ -854,7 +854,7 @@ pub static FIELDS: &[Field] = &[
         "number",
         "-",
         ZERO,
-        "in [0, 1]",
+        "in [0, 1]; > 0 needs stage1",
         "Coulomb coefficient at the sun/planet teeth",
     ),
     f(
@@ -872,8 +872,8 @@ pub static FIELDS: &[Field] = &[
         "object or null",
         "-",
         NULL,
-        "compliant joints only",
-        "Palmgren friction torque M0 + M1 of the joint bearings",
+        "compliant joints only (rigid joints: an error); rigid crank bearings have none",
+        "Palmgren friction torque M0 + M1 of the compliant joint bearings",
     ),
     f(
         "friction.bearing.f0",

@@ -203,6 +203,21 @@ impl Scene {
             }
         }
         self.friction.check()?;
+        // Friction that no model of this scene applies is refused rather than dropped.
+        if self.friction.bearing.is_some() && matches!(self.joints, Joints::Rigid) {
+            return err(
+                "friction.bearing acts in compliant bearings only (their roller or linear forces): \
+                 with joints.kind = \"rigid\" it would be ignored; set compliant joints or remove it"
+                    .into(),
+            );
+        }
+        if self.friction.mesh > 0.0 && self.stage1.is_none() {
+            return err(
+                "friction.mesh acts at the sun/planet meshes, and this scene has no first stage \
+                 (stage1 = null): remove it or give the stage"
+                    .into(),
+            );
+        }
         self.errors.check(
             self.cranks as usize,
             self.discs.len(),
