@@ -112,7 +112,7 @@ impl CompliantModel {
                 let w_drive = [sp * u[0] + cp * zu[0], sp * u[1] + cp * zu[1]];
                 let w_coast = [sp * u[0] - cp * zu[0], sp * u[1] - cp * zu[1]];
                 let mut f_report = 0.0;
-                let mut e_drive = 0.0;
+                let (mut e_drive, mut e_coast) = (0.0, 0.0);
                 for (sign, w) in [(1.0, w_drive), (-1.0, w_coast)] {
                     let zw = perp(w);
                     let mut pen = sign * rot - dot(d, w) - half;
@@ -125,6 +125,8 @@ impl CompliantModel {
                         pen += off.value;
                         if sign > 0.0 {
                             e_drive = off.value;
+                        } else {
+                            e_coast = off.value;
                         }
                     }
                     if pen <= 0.0 {
@@ -179,7 +181,14 @@ impl CompliantModel {
                     }
                     f_report += sign * f;
                 }
-                sink.mesh(i, f_report, rot - dot(d, w_drive) + e_drive);
+                // The loaded flank's approach, signed as its force (negative on the coast
+                // flank, along its own line of action): a reversed run mirrors a forward one.
+                let deflection = if f_report < 0.0 {
+                    rot + dot(d, w_coast) - e_coast
+                } else {
+                    rot - dot(d, w_drive) + e_drive
+                };
+                sink.mesh(i, f_report, deflection);
             }
         }
         for (k, disc) in m.discs.iter().enumerate() {
