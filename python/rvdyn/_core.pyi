@@ -148,8 +148,11 @@ class CycloidGeometry:
     ) -> GapResult:
         """Exact signed gap between a pin (centre (2,) [m]) and the disc placed at disc_center
         (2,) [m] turned by disc_angle [rad], fixed frame. pin_radius [m] overrides the disc's
-        pin radius. Raises ParameterError (bad input) or ConvergenceError (no unique nearest
-        point)."""
+        pin radius. Where several profile points are equally near (a pin at the disc centre, or
+        on a symmetry line far from the profile) the gap is exact and phi, point and normal
+        are one of them; at a straight profile point (K1 = 1/zp at the root) the curvature
+        radius is round-off of either sign. Raises ParameterError (bad input) or
+        ConvergenceError (the foot search fails)."""
     def pin_positions(self) -> NDArray[np.float64]:
         """Pin centres (zp, 2) [m]; row j is at angle 2 pi j / zp, the paper's pin j + 1."""
     def classical_pin_forces(self, disc_torque: float, crank_angle: float) -> NDArray[np.float64]:
@@ -162,7 +165,9 @@ class CycloidGeometry:
         crank angle psi [rad]."""
     def mass_properties(self, density: float = 7850.0) -> tuple[float, float]:
         """(mass [kg], polar inertia about the disc centre [kg m^2]) of the disc with the
-        default holes, for a density [kg/m^3]."""
+        default holes (a 40 mm bore and crank holes on a 90 mm circle: sized for the paper's
+        disc; a disc too small for them raises GeometryError, and a scene then takes its
+        inertias.disc), for a density [kg/m^3]."""
     def __reduce__(self) -> tuple[Any, ...]: ...
 
 @final
