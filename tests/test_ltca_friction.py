@@ -107,6 +107,17 @@ def test_running_efficiency_against_the_analytic_estimate() -> None:
     assert np.mean(r["reverse"]) - np.mean(r["forward"]) > np.mean(free["reverse"]) - np.mean(free["forward"])
 
 
+def test_running_sweep_over_the_whole_window() -> None:
+    # window=True covers the twelve mesh periods after which the physical preset's roller sets
+    # repeat, at the default 84 angles each; without friction the efficiency is 1.
+    scene = rvdyn.Scene.physical("rated")
+    d = running_friction(scene, RATED, window=True)
+    assert len(d["crank_angle"]) == 12 * 84
+    assert float(d["efficiency_forward"]) == pytest.approx(1.0, abs=1e-12)
+    with pytest.raises(rvdyn.ParameterError, match="window"):
+        running_friction(scene, RATED, window=1)  # type: ignore[arg-type]
+
+
 def test_running_sweep_converges_at_the_round_off_floor_far_from_zero() -> None:
     # At crank angle 48 rad (eight periods on) the frictional Newton looped to its cap at a
     # residual of 4e-12 of the load and blamed the friction coefficients; it now stops at the

@@ -170,3 +170,10 @@ def test_cli_modes_writes_table_energy_campbell_and_summary(tmp_path, capsys) ->
     assert "Mode table" in (out / "modes.md").read_text()
     assert "Campbell crossing" in capsys.readouterr().out
     assert main(["modes", "--torque", "5e6", "--out", str(out)]) == 1
+    # --harmonics reaches the Campbell diagram: fewer harmonics, fewer crossings; 0 is refused.
+    crossings = []
+    for h in ("2", "8"):
+        assert main(["modes", "--harmonics", h, "--out", str(out), "--points", "20"]) == 0
+        crossings.append(len(json.loads((out / "modes.json").read_text())["campbell"]["crossings"]))
+    assert crossings[0] < crossings[1]
+    assert main(["modes", "--harmonics", "0", "--out", str(out)]) == 1
