@@ -506,15 +506,8 @@ impl Ltca {
         let input_torque = if st.model.mesh.is_some() {
             st.input_reaction(&self.work) - qf[SUN]
         } else if st.kind == Kind::Rigid {
-            // Rigid joints, cranks held: the disc centres ride on the eccentrics,
-            // dO_k/dpsi = z x O_k; the input carries minus the forces' virtual work on them.
-            -(0..st.model.discs.len())
-                .map(|k| {
-                    let dk = st.disc_index(k);
-                    let f = [self.work.qf[dk] + qf[dk], self.work.qf[dk + 1] + qf[dk + 1]];
-                    -f[0] * x[dk + 1] + f[1] * x[dk]
-                })
-                .sum::<f64>()
+            // The elastic and the friction forces' reactions on the held cranks.
+            st.held_cranks_reaction(&self.work.qf, &x) + st.held_cranks_reaction(&qf, &x)
         } else {
             st.input_reaction(&self.work)
                 - (0..st.cranks)

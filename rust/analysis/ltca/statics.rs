@@ -1173,22 +1173,27 @@ impl Statics {
         out
     }
 
+    /// The torque [N m] held cranks of a single stage with rigid joints carry against the
+    /// generalised forces `qf` on the discs at the full coordinates `x`: the disc centres ride
+    /// on the eccentrics, `dO_k/dpsi = z x O_k`, and the cranks carry minus the forces'
+    /// virtual work on them.
+    pub(crate) fn held_cranks_reaction(&self, qf: &[f64], x: &[f64]) -> f64 {
+        -(0..self.model.discs.len())
+            .map(|k| {
+                let dk = self.disc_index(k);
+                -qf[dk] * x[dk + 1] + qf[dk + 1] * x[dk]
+            })
+            .sum::<f64>()
+    }
+
     /// The torque the held input carries [N m] (the reaction that holds it): minus the
     /// generalised force on the input coordinates in the last full evaluation.
     pub fn input_reaction(&self, work: &Work) -> f64 {
         if self.model.mesh.is_some() {
             -work.qf[SUN]
         } else if self.kind == Kind::Rigid {
-            // Rigid joints, cranks held: the disc forces never reach the crank coordinates.
-            // The disc centres ride on the eccentrics, dO_k/dpsi = z x O_k, and the input
-            // carries minus the forces' virtual work on them (as with friction).
-            let x = &work.x;
-            -(0..self.model.discs.len())
-                .map(|k| {
-                    let dk = self.disc_index(k);
-                    -work.qf[dk] * x[dk + 1] + work.qf[dk + 1] * x[dk]
-                })
-                .sum::<f64>()
+            // Rigid joints: the disc forces never reach the crank coordinates.
+            self.held_cranks_reaction(&work.qf, &work.x)
         } else {
             -(0..self.cranks)
                 .map(|i| work.qf[self.crank_index(i) + 2])
