@@ -52,6 +52,46 @@ fn bench_ltca(c: &mut Criterion) {
     });
 }
 
+/// The workload issue 9 names with the physical preset's pin law: two discs of 24 pins, the
+/// line-contact (Johnson) law with its location term, linear compliant bearings, the paper's
+/// constant mesh stiffness. It separates what the physical preset's roller bearings with
+/// clearance and ISO meshes cost from what its pin law costs.
+fn line_scene() -> Scene {
+    let mut s = Scene::paper("rated").expect("paper scene");
+    s.joints = default_joints();
+    s.contact.pin = Scene::physical("rated")
+        .expect("physical scene")
+        .contact
+        .pin;
+    s
+}
+
+fn bench_ltca_line(c: &mut Criterion) {
+    let s = line_scene();
+    let torque = s.load.torque(0.0);
+    let mut ltca = Ltca::new(&s).expect("ltca");
+    let period = ltca.mesh_period();
+    let angles: Vec<f64> = (0..360).map(|i| period * i as f64 / 360.0).collect();
+    ltca.solve(torque, 0.0).expect("first angle");
+    let mut k = 0usize;
+    c.bench_function("ltca_line/one_crank_angle_warm", |b| {
+        b.iter(|| {
+            k += 1;
+            let psi = period * (k % 360) as f64 / 360.0;
+            black_box(ltca.solve(black_box(torque), psi).expect("solve"))
+        })
+    });
+    c.bench_function("ltca_line/mesh_period_360_angles", |b| {
+        b.iter(|| {
+            ltca.reset();
+            black_box(ltca.sweep(black_box(torque), &angles).expect("sweep"))
+        })
+    });
+    c.bench_function("ltca_line/twist_loop_200_points", |b| {
+        b.iter(|| black_box(ltca.twist_loop(black_box(torque), 0.0, 200).expect("loop")))
+    });
+}
+
 fn bench_ltca_physical(c: &mut Criterion) {
     let s = Scene::physical("rated").expect("physical scene");
     let torque = s.load.torque(0.0);
@@ -92,6 +132,6 @@ fn bench_ltca_physical(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = bench_ltca, bench_ltca_physical
+    targets = bench_ltca, bench_ltca_line, bench_ltca_physical
 }
 criterion_main!(benches);

@@ -7,8 +7,9 @@
 //!     target/release/examples/ltca_work physical period 1
 //! ```
 //!
-//! `PRESET WORKLOAD N` with PRESET `physical` (`Scene::physical("rated")`) or `paper` (the
-//! paper scene with compliant bearings and the Palmgren line law, as `benches/ltca.rs`) and
+//! `PRESET WORKLOAD N` with PRESET `physical` (`Scene::physical("rated")`), `paper` (the
+//! paper scene with compliant bearings and the Palmgren line law, as `benches/ltca.rs`) or
+//! `line` (the same with the physical preset's line-contact pin law, as `ltca_line`) and
 //! WORKLOAD `warm` (N warm crank angles with the full report, 1/360 of the period apart), `cold`
 //! (N crank angles at 0.1 rad from the kinematic pose, as the bench's `one_crank_angle_cold`),
 //! `period` (N sweeps of 360 crank angles over the mesh period with full reports), `bare` (N
@@ -31,9 +32,13 @@ fn scene(preset: &str) -> Result<Scene, Box<dyn std::error::Error>> {
     }
     let mut s = Scene::paper("rated")?;
     s.joints = default_joints();
-    s.contact.pin = ContactLawSpec::Palmgren {
-        max_damping: 1e5,
-        damping_depth: 1e-5,
+    s.contact.pin = if preset == "line" {
+        Scene::physical("rated")?.contact.pin
+    } else {
+        ContactLawSpec::Palmgren {
+            max_damping: 1e5,
+            damping_depth: 1e-5,
+        }
     };
     Ok(s)
 }

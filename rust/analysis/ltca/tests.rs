@@ -344,8 +344,14 @@ fn bench_reference_errors() {
         max_damping: 1e5,
         damping_depth: 1e-5,
     };
+    // The bench's `ltca_line` scene: the paper's with linear compliant bearings and the
+    // physical preset's line-contact pin law.
+    let mut line = Scene::paper("rated").unwrap();
+    line.joints = default_joints();
+    line.contact.pin = Scene::physical("rated").unwrap().contact.pin;
     for (name, s) in [
         ("paper", paper),
+        ("line", line),
         ("physical", Scene::physical("rated").unwrap()),
     ] {
         println!("{name}:");
@@ -439,8 +445,14 @@ fn cpu_time_report() {
         max_damping: 1e5,
         damping_depth: 1e-5,
     };
+    // The bench's `ltca_line` scene: the paper's with linear compliant bearings and the
+    // physical preset's line-contact pin law.
+    let mut line = Scene::paper("rated").unwrap();
+    line.joints = default_joints();
+    line.contact.pin = Scene::physical("rated").unwrap().contact.pin;
     for (name, s) in [
         ("paper", paper),
+        ("line", line),
         ("physical", Scene::physical("rated").unwrap()),
     ] {
         let rated = s.load.torque(0.0);
