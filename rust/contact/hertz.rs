@@ -130,7 +130,9 @@ pub struct LineContact {
 /// term carries it, so the result is a model value, not a unique physical one.
 ///
 /// Errors: `Parameter` for a negative or non-finite force, non-positive length, invalid
-/// material; `Geometry` from [`effective_radius`]. Zero force gives all-zero output.
+/// material, results beyond floating point, or a half-width wider than the smaller radius
+/// (outside Hertz theory); `Geometry` from [`effective_radius`]. Zero force gives all-zero
+/// output.
 pub fn hertz_line_contact(
     force: f64,
     length: f64,
@@ -174,12 +176,27 @@ pub fn hertz_line_contact(
     if !(values.iter().all(|v| v.is_finite()) && p.is_finite() && p > 0.0) {
         return Err(RvdynError::Parameter(format!(
             "the Hertz contact of force {} N over length {} m (radii {} m, {} m) is beyond the \
-             range of floating point (line load {} N/m): give a force and length of physical \
-             size",
+             range of floating point (line load {} N/m): give a force, length and radii of \
+             physical size",
             num(force),
             num(length),
             num(r1),
             num(r2),
+            num(p)
+        )));
+    }
+    // Hertz's half-spaces need a strip narrow against both bodies; one wider than the smaller
+    // radius is no contact of cylinders (and past 2.4 times it the approach turns negative).
+    let r_min = r1.abs().min(r2.abs());
+    if a > r_min {
+        return Err(RvdynError::Parameter(format!(
+            "the Hertz half-width {} m of force {} N over length {} m is wider than the smaller \
+             radius {} m: Hertz theory needs a contact strip narrow against the radii; lower the \
+             line load (force / length, now {} N/m) or check the radii",
+            num(a),
+            num(force),
+            num(length),
+            num(r_min),
             num(p)
         )));
     }
@@ -366,6 +383,15 @@ mod tests {
             e.to_string().contains("1e308") && e.to_string().len() < 400,
             "{e}"
         );
+        // A strip wider than the smaller radius is outside Hertz theory: an error naming the
+        // radius, not a negative approach (force 1e12 N: a = 0.6 m against r1 = 0.01 m).
+        let e = hertz_line_contact(1e12, 0.04, 0.01, 0.1, &m, &m).unwrap_err();
+        assert!(
+            matches!(e, RvdynError::Parameter(_)) && e.to_string().contains("smaller radius"),
+            "{e}"
+        );
+        // The radius itself too small for the force (a = 1.0e-9 m > r1 = 1e-12 m).
+        assert!(hertz_line_contact(1e3, 0.01, 1e-12, 0.01, &m, &m).is_err());
         // The rearranged closed forms agree with the textbook ones at ordinary loads.
         let c = hertz_line_contact(5e3, 0.04, 0.01, 0.1, &m, &m).unwrap();
         let (p, r, es) = (

@@ -199,9 +199,13 @@ pub fn contact_stiffness_terms(width: f64, p: &StiffnessParams) -> Result<Stiffn
     };
     if b > 0.0 && bracket <= 0.0 {
         return Err(RvdynError::Parameter(format!(
-            "contact width {} m is too small for eq. 9: the Hertz width b = {} m exceeds the \
-             radii so the deformation is {} m <= 0; use a width of at least a few micrometres",
+            "contact width {} m is too small for eq. 9 at penetration {} m: the force k' x^e = \
+             {} N gives a Hertz width b = {} m that exceeds the radii, so the deformation is {} \
+             m <= 0; use a width of at least a few micrometres or a smaller penetration (the \
+             paper's is 1e-5 m)",
             num(width),
+            num(p.penetration),
+            num(force),
             num(b / MM_PER_M),
             num(w / MM_PER_M)
         )));

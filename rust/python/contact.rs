@@ -187,7 +187,8 @@ fn stiffness_maximum(
 /// ------
 /// ParameterError
 ///     Negative or non-finite force, non-positive width, invalid material, shapes that do not
-///     broadcast.
+///     broadcast, results beyond floating point, or a half width wider than the smaller
+///     radius (outside Hertz theory).
 /// GeometryError
 ///     Radii that cannot make a Hertz contact (zero, concave-concave, conformal or nested).
 #[pyfunction]
