@@ -145,6 +145,16 @@ def test_bad_options_raise_parameter_errors() -> None:
             simulate(scene, **kwargs)  # type: ignore[arg-type]
     with pytest.raises(rvdyn.ParameterError, match="unknown integrator"):
         simulate(scene, 0.1, "euler")
+    # A sample interval longer than the run recorded only t = 0.
+    with pytest.raises(rvdyn.ParameterError, match="record_interval must be <= t_end"):
+        simulate(scene, 1e-3, record_interval=2e-3)
+
+
+def test_a_run_shorter_than_the_default_interval_records_its_end() -> None:
+    r = simulate(Scene.paper("idle"), 5e-5, channels=["motion"])
+    assert list(r.t) == pytest.approx([0.0, 5e-5], rel=1e-12)
+    r = simulate(Scene.paper("idle"), 1e-3, record_interval=1e-3, channels=["motion"])
+    assert list(r.t) == pytest.approx([0.0, 1e-3], rel=1e-12)
     with pytest.raises(rvdyn.ParameterError, match="rvdyn.Scene"):
         simulate({"name": "x"}, 0.1)  # type: ignore[arg-type]
 

@@ -366,7 +366,7 @@ class Options:
     integrator: "generalized-alpha" (default), "generalized-alpha-adaptive", "dopri5" or "rk4";
     dt [s] (None = the integrator's default: 1e-4, 1e-5 (initial), 1e-6 (initial), 1e-5 s);
     rtol (adaptive, velocities, default 1e-6); atol [m] (displacement tolerance, default
-    1e-9 m); rho_inf in [0, 1] (default 0.8); record_interval [s] (None = 1e-4 s); max_samples
+    1e-9 m); rho_inf in [0, 1] (default 0.8); record_interval [s], <= t_end (None = 1e-4 s or t_end if shorter); max_samples
     (default 50 000); channels (groups: "motion", "pins", "contact_points", "mesh", "energy",
     "bearings"; None = all but contact points); skip_separated (default True); step_check
     ("warn", "raise" or "off": a fixed step that cannot be accurate, default "warn"); h_min [s]

@@ -110,8 +110,9 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     (``Scene.physical``) runs dopri5 at atol 1e-8 m, rtol 1e-4 (``ROLLER_DEFAULT``: 3.9e-4 of the
     peak pin force, where generalized-alpha at dt 1e-4 s is off by 3 %); other scenes
     generalized-alpha.
-    record_interval: sample spacing [s] (default 1e-4 s), coarsened so that at most
-    ``max_samples`` (default 50 000) samples are kept, which bounds memory on long runs.
+    record_interval: sample spacing [s], at most ``t_end`` (default 1e-4 s, or ``t_end`` for
+    a shorter run), coarsened so that at most ``max_samples`` (default 50 000) samples are
+    kept, which bounds memory on long runs.
     channels: any of ``"motion"``, ``"pins"``, ``"contact_points"``, ``"mesh"``, ``"energy"``,
     ``"bearings"``
     (default all but ``"contact_points"``); channels not asked for are not computed.

@@ -131,6 +131,15 @@ impl SimOptions {
                 "dt must be > 0 s and <= t_end, got {dt}"
             )));
         }
+        if let Some(r) = self.record_interval
+            && r > self.t_end
+        {
+            return Err(RvdynError::Parameter(format!(
+                "record_interval must be <= t_end, got {r} s against t_end = {} s: a longer \
+                 interval records only t = 0; shorten it or leave it None",
+                self.t_end
+            )));
+        }
         self.validate_settings()?;
         // A bound on the work: a fixed-step run of more than MAX_STEPS steps is a mistake
         // (dt = 1e-300 would never end), not a request.
@@ -196,7 +205,8 @@ impl SimOptions {
 
     /// The sample interval actually used \[s\].
     pub fn sample_interval(&self) -> f64 {
-        let wanted = self.record_interval.unwrap_or(1e-4);
+        // The default 1e-4 s, but never past the end: a shorter run still records its end.
+        let wanted = self.record_interval.unwrap_or(1e-4_f64.min(self.t_end));
         wanted.max(self.t_end / (self.max_samples - 1) as f64)
     }
 }
@@ -495,6 +505,23 @@ mod tests {
         fn stats(&self) -> Stats {
             self.0.stats()
         }
+    }
+
+    #[test]
+    fn the_sample_interval_stays_within_the_run() {
+        let mut opt = SimOptions::new(1e-3, Method::GeneralizedAlpha);
+        opt.record_interval = Some(2e-3);
+        let e = opt.validate().unwrap_err();
+        assert!(
+            e.to_string().contains("record_interval must be <= t_end"),
+            "{e}"
+        );
+        opt.record_interval = Some(1e-3);
+        assert!(opt.validate().is_ok());
+        // The default 1e-4 s shrinks to the end of a shorter run.
+        let opt = SimOptions::new(5e-5, Method::GeneralizedAlpha);
+        assert_eq!(opt.sample_interval(), 5e-5);
+        assert_eq!(SimOptions::new(1.0, Method::Dopri5).sample_interval(), 1e-4);
     }
 
     fn count(s: &Stats, name: &str) -> u64 {
