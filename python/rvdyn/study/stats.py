@@ -238,8 +238,9 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
     the same order) from a Saltelli design of ``n`` base samples (a power of 2): the kernel
     runs n (d + 2) times on ``runner``. ``intervals`` holds bootstrap confidence intervals at
     level ``confidence`` (None: none) from ``n_resamples`` resamples (SciPy's BCa bootstrap of
-    the Saltelli design; ``seed`` fixes the design and the indices, while SciPy draws the
-    bootstrap resamples unseeded, so the interval ends vary by about 1/sqrt(n_resamples)). Independent tolerances only; a failed
+    the Saltelli design; ``seed`` fixes the design, the indices and the resamples, so a seeded
+    call repeats to the last digit; ``seed=None`` varies the interval ends by about
+    1/sqrt(n_resamples) between calls). Independent tolerances only; a failed
     sample (or a metric the kernel does not give) makes every index NaN and leaves out the
     intervals: SciPy would read the NaN outputs as 0 and report no sensitivity at all."""
     from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
@@ -299,9 +300,17 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
     order = np.argsort(-np.abs(first), kind="stable")
     intervals: tuple[tuple[float, float, float, float], ...] = ()
     if confidence is not None and np.all(np.isfinite(first)) and np.all(np.isfinite(total)):
-        # SciPy's SobolResult.bootstrap (BCa over the Saltelli design's rows); it takes no
-        # generator, so its resamples (not the indices) change from call to call.
-        boot = res.bootstrap(confidence_level=confidence, n_resamples=n_resamples)
+        # SciPy's SobolResult.bootstrap (BCa over the Saltelli design's rows) takes no
+        # generator and draws from NumPy's global RandomState: seed that from ``seed`` for
+        # the call and put the caller's state back.
+        saved = np.random.get_state() if seed is not None else None
+        try:
+            if seed is not None:
+                np.random.seed(np.random.SeedSequence([int(seed), 0x50B01]).generate_state(1)[0])
+            boot = res.bootstrap(confidence_level=confidence, n_resamples=n_resamples)
+        finally:
+            if saved is not None:
+                np.random.set_state(saved)
         f_ci = boot.first_order.confidence_interval
         t_ci = boot.total_order.confidence_interval
         lo_f, hi_f = np.asarray(f_ci.low).ravel(), np.asarray(f_ci.high).ravel()
