@@ -177,8 +177,8 @@ class InvoluteStage:
     Parameters: z_sun, z_planet (>= 5 teeth), planets (>= 1), module [m], pressure_angle [rad]
     in (0, 45 deg), face_width [m], backlash [m] along the line of action (>= 0).
 
-    Raises GeometryError (too few teeth, colliding planets, contact ratio < 1) and
-    ParameterError (non-finite or non-positive sizes, pressure angle out of range).
+    Raises GeometryError (too few teeth, colliding planets, involute interference, contact
+    ratio < 1) and ParameterError (non-finite or non-positive sizes, pressure angle out of range).
     """
 
     def __new__(

@@ -490,7 +490,8 @@ impl PyCycloidGeometry {
 /// Raises
 /// ------
 /// GeometryError
-///     Too few teeth, no planet, colliding planets (tip circles overlap), contact ratio < 1.
+///     Too few teeth, no planet, colliding planets (tip circles overlap), involute
+///     interference (a tip reaching below the other gear's base circle), contact ratio < 1.
 /// ParameterError
 ///     Non-finite or non-positive sizes, pressure angle out of range, negative backlash.
 #[pyclass(name = "InvoluteStage", module = "rvdyn", frozen)]
