@@ -19,36 +19,14 @@ fn scene() -> Scene {
 }
 
 fn bench_ltca(c: &mut Criterion) {
-    let s = scene();
-    let torque = s.load.torque(0.0);
-    let mut ltca = Ltca::new(&s).expect("ltca");
-    let period = ltca.mesh_period();
-    let angles: Vec<f64> = (0..360).map(|i| period * i as f64 / 360.0).collect();
     // One crank angle in a sweep: warm-started from the previous angle, a step of 1/360 of
-    // the period.
-    ltca.solve(torque, 0.0).expect("first angle");
-    let mut k = 0usize;
-    c.bench_function("ltca/one_crank_angle_warm", |b| {
-        b.iter(|| {
-            k += 1;
-            let psi = period * (k % 360) as f64 / 360.0;
-            black_box(ltca.solve(black_box(torque), psi).expect("solve"))
-        })
-    });
+    // the period; and one from the kinematic pose.
+    let (mut ltca, torque) = bench_sweeps(c, "ltca", &scene());
     c.bench_function("ltca/one_crank_angle_cold", |b| {
         b.iter(|| {
             ltca.reset();
             black_box(ltca.solve(black_box(torque), 0.1).expect("solve"))
         })
-    });
-    c.bench_function("ltca/mesh_period_360_angles", |b| {
-        b.iter(|| {
-            ltca.reset();
-            black_box(ltca.sweep(black_box(torque), &angles).expect("sweep"))
-        })
-    });
-    c.bench_function("ltca/twist_loop_200_points", |b| {
-        b.iter(|| black_box(ltca.twist_loop(black_box(torque), 0.0, 200).expect("loop")))
     });
 }
 
@@ -66,56 +44,44 @@ fn line_scene() -> Scene {
     s
 }
 
-fn bench_ltca_line(c: &mut Criterion) {
-    let s = line_scene();
+/// The warm crank angle (1/360 of the mesh period from the last), the 360-angle period and
+/// the 200-point loop of `s` at its load, named `{group}/...`; returns the analysis, warm.
+fn bench_sweeps(c: &mut Criterion, group: &str, s: &Scene) -> (Ltca, f64) {
     let torque = s.load.torque(0.0);
-    let mut ltca = Ltca::new(&s).expect("ltca");
+    let mut ltca = Ltca::new(s).expect("ltca");
     let period = ltca.mesh_period();
     let angles: Vec<f64> = (0..360).map(|i| period * i as f64 / 360.0).collect();
     ltca.solve(torque, 0.0).expect("first angle");
     let mut k = 0usize;
-    c.bench_function("ltca_line/one_crank_angle_warm", |b| {
+    c.bench_function(&format!("{group}/one_crank_angle_warm"), |b| {
         b.iter(|| {
             k += 1;
             let psi = period * (k % 360) as f64 / 360.0;
             black_box(ltca.solve(black_box(torque), psi).expect("solve"))
         })
     });
-    c.bench_function("ltca_line/mesh_period_360_angles", |b| {
+    c.bench_function(&format!("{group}/mesh_period_360_angles"), |b| {
         b.iter(|| {
             ltca.reset();
             black_box(ltca.sweep(black_box(torque), &angles).expect("sweep"))
         })
     });
-    c.bench_function("ltca_line/twist_loop_200_points", |b| {
+    c.bench_function(&format!("{group}/twist_loop_200_points"), |b| {
         b.iter(|| black_box(ltca.twist_loop(black_box(torque), 0.0, 200).expect("loop")))
     });
+    (ltca, torque)
+}
+
+fn bench_ltca_line(c: &mut Criterion) {
+    bench_sweeps(c, "ltca_line", &line_scene());
 }
 
 fn bench_ltca_physical(c: &mut Criterion) {
-    let s = Scene::physical("rated").expect("physical scene");
-    let torque = s.load.torque(0.0);
-    let mut ltca = Ltca::new(&s).expect("ltca");
-    let period = ltca.mesh_period();
-    let angles: Vec<f64> = (0..360).map(|i| period * i as f64 / 360.0).collect();
-    ltca.solve(torque, 0.0).expect("first angle");
-    let mut k = 0usize;
-    c.bench_function("ltca_physical/one_crank_angle_warm", |b| {
-        b.iter(|| {
-            k += 1;
-            let psi = period * (k % 360) as f64 / 360.0;
-            black_box(ltca.solve(black_box(torque), psi).expect("solve"))
-        })
-    });
-    c.bench_function("ltca_physical/mesh_period_360_angles", |b| {
-        b.iter(|| {
-            ltca.reset();
-            black_box(ltca.sweep(black_box(torque), &angles).expect("sweep"))
-        })
-    });
-    c.bench_function("ltca_physical/twist_loop_200_points", |b| {
-        b.iter(|| black_box(ltca.twist_loop(black_box(torque), 0.0, 200).expect("loop")))
-    });
+    let (mut ltca, torque) = bench_sweeps(
+        c,
+        "ltca_physical",
+        &Scene::physical("rated").expect("physical scene"),
+    );
     // `transmission_error(scene, window=False)`: one mesh period at 336 angles, loaded and at
     // the light load 1e-6 of the torque, both directions, extremes located between the angles
     // (the window is twelve of these).
