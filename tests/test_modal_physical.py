@@ -96,3 +96,16 @@ def test_damped_matching_follows_the_damping_continuously() -> None:
         assert lam.imag / (2 * np.pi) == pytest.approx(m.damped_frequency[j], rel=1e-9)
         assert -lam.real / abs(lam) == pytest.approx(m.damping_ratio[j], rel=1e-9)
     assert m.damped_frequency[0] > 1.2 * m.frequency[0]
+
+
+def test_friction_is_left_out_of_the_linearisation_about_an_equilibrium() -> None:
+    # About an equilibrium (a slowly turning reducer) the regularised Coulomb law's slope at
+    # rest, mu N / v_reg, is an artefact: it made the main mode's damping ratio 1.0 at
+    # v_reg = 1e-3 m/s and 0.10 at 1e-2 (0.050 without friction).
+    base = rvdyn.modes(rvdyn.Scene.physical("rated"), crank_angle=0.1)
+    for v_reg in (1e-5, 1e-2):
+        s = rvdyn.Scene.physical("rated").replace(**{"friction.pin": 0.05, "friction.mesh": 0.05,
+                                                     "friction.regularisation_speed": v_reg})
+        m = rvdyn.modes(s, crank_angle=0.1)
+        np.testing.assert_allclose(m.damping_ratio, base.damping_ratio, rtol=1e-12)
+        np.testing.assert_allclose(m.frequency, base.frequency, rtol=1e-12)

@@ -80,6 +80,10 @@ pub struct Equilibrium {
     pub dynamic_state: (Vec<f64>, Vec<f64>),
     /// Time of the dynamic state \[s\] (0 for an equilibrium).
     pub time: f64,
+    /// An LTCA equilibrium (true) or a dynamic state (false): about an equilibrium, which
+    /// stands for a slowly turning reducer, the scene's friction is left out (see
+    /// [`Linearizer::linearise_about`]).
+    pub is_equilibrium: bool,
 }
 
 /// Linearises one scene about LTCA equilibria (warm-started from the previous one).
@@ -91,6 +95,8 @@ pub struct Linearizer {
     names: Vec<String>,
     mass: Vec<f64>,
     dynamic: Dynamic,
+    /// The same model without the scene's friction, for equilibria (`None`: no friction).
+    frictionless: Option<Dynamic>,
     /// Coordinates added for the shafts (after the LTCA unknowns).
     extra: Vec<Extra>,
     /// Index of each linearisation coordinate in the dynamic model's full coordinates.
@@ -146,6 +152,19 @@ impl Linearizer {
         if scene.shafts.input.is_some() && matches!(scene.drive, Drive::Torque { .. }) {
             extra.push(Extra::Motor);
         }
+        // Regularised Coulomb friction about a state at rest has the slope mu N / v_reg, an
+        // artefact of the regularisation; a slowly turning reducer slides at speeds far above
+        // v_reg, where the friction force does not change with a small velocity change.
+        let frictionless = if scene.friction.any() {
+            let mut s = free_scene.clone();
+            s.friction = crate::dynamics::scene::Friction::default();
+            Some(match scene.joints {
+                Joints::Rigid => Dynamic::Rigid(Box::new(RigidModel::new(&s)?)),
+                Joints::Compliant { .. } => Dynamic::Compliant(Box::new(CompliantModel::new(&s)?)),
+            })
+        } else {
+            None
+        };
         let (mut names, mut mass, dynamic): (Vec<String>, Vec<f64>, Dynamic) = match scene.joints {
             Joints::Rigid => {
                 let m = RigidModel::new(&free_scene)?;
@@ -231,6 +250,7 @@ impl Linearizer {
             names,
             mass,
             dynamic,
+            frictionless,
             extra,
             dyn_index,
             dyn_pos,
@@ -291,6 +311,7 @@ impl Linearizer {
             shaft_angles,
             dynamic_state,
             time: 0.0,
+            is_equilibrium: true,
         })
     }
 
@@ -402,6 +423,7 @@ impl Linearizer {
             shaft_angles,
             dynamic_state: (x, xv),
             time: t,
+            is_equilibrium: false,
         })
     }
 
@@ -626,7 +648,11 @@ impl Linearizer {
             vc[p] += v[a];
         }
         let mut f = vec![0.0; nc];
-        match &self.dynamic {
+        let model = match (&self.frictionless, eq.is_equilibrium) {
+            (Some(m), true) => m,
+            _ => &self.dynamic,
+        };
+        match model {
             Dynamic::Rigid(m) => {
                 RigidSystem::new(m).generalized_force(eq.time, &qc, &vc, &mut f)?
             }
