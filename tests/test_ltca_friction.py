@@ -38,6 +38,22 @@ def test_friction_off_is_the_frictionless_loop() -> None:
     assert c.width(0.5 * RATED) > 1e-3 * c.twist.max()
 
 
+def test_bearing_friction_reaches_the_static_analyses() -> None:
+    """A compliant scene with bearing friction: the LTCA, the loop, the modes and the mass
+    properties accept it (their rigid copy of the scene refused it as a rigid scene with
+    bearing friction), and the bearings' Palmgren torque widens the loop a little."""
+    bearing = {"f0": 3.0, "f1": 3e-4, "viscosity": 68e-6}
+    teeth = rvdyn.Scene.physical("rated", friction={"pin": 0.05, "mesh": 0.05})
+    both = rvdyn.Scene.physical("rated", friction={"pin": 0.05, "mesh": 0.05, "bearing": bearing})
+    a = torque_twist(teeth, RATED, 0.0, 41)
+    b = torque_twist(both, RATED, 0.0, 41)
+    assert b.width(0.5 * RATED) > a.width(0.5 * RATED) * (1 + 1e-3)
+    assert b.backlash > a.backlash
+    assert rvdyn.ltca(both, None, [0.0]).arrays["pin_force"].max() > 0
+    assert both.model_info()["generalized_mass"] == teeth.model_info()["generalized_mass"]
+    assert rvdyn.modes(both).frequency[0] == pytest.approx(rvdyn.modes(teeth).frequency[0], rel=1e-12)
+
+
 def test_loop_width_is_the_friction_moment_over_the_stiffness() -> None:
     """Width at half the rated torque against ``2 mu S / k`` (first order in mu; the second-
     order terms of the two branches cancel in the width): S = sum N |arm . n| over the loaded

@@ -180,9 +180,7 @@ fn model_info<'py>(py: Python<'py>, sc: &Scene) -> PyResult<Bound<'py, PyDict>> 
         Joints::Rigid => None,
         Joints::Compliant { .. } => Some(CompliantModel::new(sc)?.dof()),
     };
-    let mut rigid = sc.clone();
-    rigid.joints = Joints::Rigid;
-    let model = RigidModel::new(&rigid)?;
+    let model = RigidModel::new(&sc.rigid_counterpart())?;
     let d = PyDict::new(py);
     let i = model.inertias;
     for (name, mp) in [

@@ -262,10 +262,7 @@ impl Statics {
                     .into(),
             ));
         }
-        let mut rigid_scene = scene.clone();
-        rigid_scene.joints = Joints::Rigid;
-        rigid_scene.errors = Default::default();
-        let model = RigidModel::new(&rigid_scene)?;
+        let model = RigidModel::new(&scene.rigid_counterpart())?;
         let (kind, eccentric_bearing, crank_bearing) = match scene.joints {
             Joints::Rigid => (Kind::Rigid, None, None),
             Joints::Compliant {

@@ -803,6 +803,18 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The same reducer with rigid joints, for what only the rigid model's geometry, laws and
+    /// masses are wanted from (the LTCA's laws, the mass properties): without the assembly
+    /// errors and the bearing friction that only compliant joints carry, which a rigid scene
+    /// refuses.
+    pub fn rigid_counterpart(&self) -> Scene {
+        let mut s = self.clone();
+        s.joints = Joints::Rigid;
+        s.errors = AssemblyErrors::default();
+        s.friction.bearing = None;
+        s
+    }
+
     /// Parse a scene from JSON text.
     pub fn from_json(text: &str) -> Result<Self> {
         let v: serde_json::Value = serde_json::from_str(text)
