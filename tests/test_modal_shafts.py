@@ -65,3 +65,13 @@ def test_soft_output_shaft_mode_matches_the_free_vibration_of_a_run() -> None:
     f = np.fft.rfftfreq(n, 2e-4)
     peak = f[np.argmax(np.abs(np.fft.rfft(x * np.hanning(len(x)), n)))]
     assert peak == pytest.approx(m.damped_frequency[0], rel=0.01)
+
+
+def test_a_speed_drive_holds_the_motor_so_its_inertia_is_not_needed() -> None:
+    # The linearisation's torque-driven copy of the scene asked for a motor inertia that a
+    # speed-driven scene (which holds the motor) need not give: a SceneError before.
+    held = rvdyn.Scene.paper("rated").replace(**{"shafts.input": {"stiffness": 1e5}})
+    m = rvdyn.modes(held)
+    assert m.dof_names[-1] == "sun angle" and "motor angle" not in m.dof_names
+    with_motor = rvdyn.modes(held.replace(**{"inertias.motor_inertia": 0.01}))
+    np.testing.assert_array_equal(m.frequency, with_motor.frequency)

@@ -136,6 +136,14 @@ impl Linearizer {
             ramp_time: 0.0,
         };
         free_scene.load = Load::Idle;
+        // A speed drive holds the motor: it is no coordinate of the linearisation, but the
+        // torque-driven copy has it free and needs some inertia for it (never used).
+        if matches!(scene.drive, Drive::Speed { .. })
+            && scene.shafts.input.is_some()
+            && free_scene.inertias.motor_inertia <= 0.0
+        {
+            free_scene.inertias.motor_inertia = 1.0;
+        }
         // Only forces are evaluated: the initial state does not matter (and a steady start
         // needs a speed drive).
         free_scene.initial = crate::dynamics::scene::Initial::Rest;
