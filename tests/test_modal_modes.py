@@ -132,6 +132,15 @@ def test_unloaded_equilibria_are_refused_or_flagged() -> None:
     for scene in (rvdyn.Scene.physical("rated"), rvdyn.Scene.paper("idle")):
         with pytest.raises(rvdyn.ParameterError, match="need a load"):
             rvdyn.modes(scene, torque=0.0 if scene["name"] == "physical" else None)
+    # The sweeps over crank angle and speed refuse it too (they returned round-off silently).
+    with pytest.raises(rvdyn.ParameterError, match="need a load"):
+        rvdyn.modes_over_mesh(rvdyn.Scene.paper("idle"), points=2)
+    with pytest.raises(rvdyn.ParameterError, match="need a load"):
+        rvdyn.modes_over_mesh(rvdyn.Scene.physical("rated"), torque=0.0, points=2)
+    with pytest.raises(rvdyn.ParameterError, match="need a load"):
+        rvdyn.campbell(rvdyn.Scene.paper("idle"), [100.0, 200.0])
+    with pytest.raises(rvdyn.ParameterError, match="needs a load"):
+        rvdyn.campbell(rvdyn.Scene.paper("rated"), [100.0, 200.0], power=0.0)
     with pytest.warns(RuntimeWarning, match="2 of 16 modes have no stiffness"):
         m = rvdyn.modes(rvdyn.Scene.physical("rated"), torque=1.0)
     assert int(np.sum(np.isnan(m.damping_ratio))) == 2

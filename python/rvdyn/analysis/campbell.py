@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import ParameterError
-from .modes import _finite, _scene, scene_torque
+from .modes import _finite, _loaded_torque, _scene
 from ..plotting import _whole
 from .spectrum import MAX_HARMONICS, ExcitationOrder
 
@@ -114,7 +114,8 @@ def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, 
     harmonics up to ``harmonics``. The default 8 is set by the ISO 6336 mesh stiffness: a
     rectangular wave between one and two tooth pairs, whose harmonics fall only as ``1/h``
     (4 and 7 are strong at the paper's contact ratio 1.63, and the 4th sun-mesh harmonic meets
-    the physical preset's main mode at 8488 deg/s, 2 % above the paper's input speed)."""
+    the physical preset's main mode at 8488 deg/s, 2 % above the paper's input speed). A zero
+    torque or power is a ``ParameterError``: unloaded contacts have no stiffness."""
     scene = _scene(scene)
     n_harmonics = _whole("harmonics", harmonics, 1, MAX_HARMONICS)
     if speeds is None:
@@ -129,9 +130,12 @@ def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, 
         with np.errstate(divide="ignore"):
             t = p * float(scene.ratio) / w
     else:
-        t = np.full(w.shape, scene_torque(scene) if torque is None else _finite("torque", torque, "N m"))
+        t = np.full(w.shape, _loaded_torque(scene, torque, "campbell"))
     if not np.all(np.isfinite(t)):
         raise ParameterError("input speeds must be finite and > 0 rad/s")
+    if np.any(t == 0.0):
+        raise ParameterError("campbell about equilibria needs a load: power 0 W leaves the contacts without "
+                             "load and every frequency would be round-off; give a power or torque")
     if frequency_range is not None:
         frequency_range = (_finite("frequency_range[0]", frequency_range[0], "Hz"),
                            _finite("frequency_range[1]", frequency_range[1], "Hz"))

@@ -170,6 +170,17 @@ class Modes:
         return ax
 
 
+def _loaded_torque(scene: Any, torque: float | None, what: str) -> float:
+    """The torque [N m] of an equilibrium the modes are taken about: not zero."""
+    t = scene_torque(scene) if torque is None else _finite("torque", torque, "N m")
+    if t == 0.0:
+        raise ParameterError(
+            f"{what} about an equilibrium need a load: at 0 N m the contacts carry nothing and have no "
+            "stiffness (a Hertz law's tangent is zero at zero load), so every frequency would be "
+            "round-off; give a torque (e.g. the rated 43921.3 N m) or, for modes, state=(t, q, v) of a run")
+    return t
+
+
 def modes(scene: Any, torque: float | None = None, crank_angle: float = 0.0, *,
           state: tuple[float, Sequence[float], Sequence[float]] | None = None) -> Modes:
     """Modes of ``scene`` (rigid or compliant joints, with or without machine shafts) about
@@ -195,12 +206,7 @@ def modes(scene: Any, torque: float | None = None, crank_angle: float = 0.0, *,
             raise ParameterError("state must be a (t, q, v) triple") from None
         return Modes._from_core(_core.modes_state(scene.to_json(), _finite("state time", t_s, "s"),
                                                   _as_list(q), _as_list(v)))
-    t = scene_torque(scene) if torque is None else _finite("torque", torque, "N m")
-    if t == 0.0:
-        raise ParameterError(
-            "modes about an equilibrium need a load: at 0 N m the contacts carry nothing and have no "
-            "stiffness (a Hertz law's tangent is zero at zero load), so every frequency would be "
-            "round-off; give a torque (e.g. the rated 43921.3 N m) or state=(t, q, v) of a run")
+    t = _loaded_torque(scene, torque, "modes")
     psi = _finite("crank_angle", crank_angle, "rad")
     m = Modes._from_core(_core.modes(scene.to_json(), t, [psi])[0])
     floating = int(sum(bool(r) for r in m.extra["rigid_body"]))
@@ -302,9 +308,9 @@ def modes_over_mesh(scene: Any, torque: float | None = None, points: int = 25,
     reducer) is shorter, so a pin pitch covers its single- and double-tooth zones, but the whole
     pattern repeats only after the mesh period (``rvdyn.ltca(...).mesh_period``, 23/24 of a
     turn on the physical preset); with pin errors only after ``2 pi``. Give ``period`` to
-    sweep either. Torque [N m] as in :func:`modes`."""
+    sweep either. Torque [N m] as in :func:`modes` (not zero: ``ParameterError``)."""
     scene = _scene(scene)
-    t = scene_torque(scene) if torque is None else _finite("torque", torque, "N m")
+    t = _loaded_torque(scene, torque, "modes_over_mesh")
     if not isinstance(points, (int, np.integer)) or points < 2:
         raise ParameterError(f"points must be a whole number >= 2, got {points!r}")
     per = 2 * math.pi / int(scene["cycloid.pins"]) if period is None else _finite("period", period, "rad")
