@@ -51,7 +51,10 @@ class Crossing:
 @dataclass
 class CampbellDiagram:
     """Natural frequencies [Hz] (speeds, modes) over input ``speeds`` [rad/s] with the output
-    torque [N m] at each speed, the damping ratios, the excitation orders and the crossings."""
+    torque [N m] at each speed, the damping ratios, the excitation orders and the crossings.
+    Each frequency is that of the mode's matched damped eigenvalue(s), ``|lambda| / 2 pi``,
+    where the mode resonates (the undamped frequency when unmatched; equal to it for
+    proportional damping, as on the physical preset)."""
 
     speeds: np.ndarray
     torques: np.ndarray

@@ -190,16 +190,8 @@ pub(super) fn damped_modes(
                     None
                 }
             }
-            [(ci, m)] => {
-                let l = cands[*ci].lambda.re;
-                (l.abs() > zero).then(|| Matched {
-                    eigenvalue: cands[*ci].lambda,
-                    natural_omega: l.abs(),
-                    damping_ratio: -l.signum(),
-                    mac: *m,
-                    reduced_shape: cands[*ci].x.clone(),
-                })
-            }
+            // One real root alone defines no damping ratio (an overdamped mode has two): the
+            // mode stays unmatched rather than given a ratio of 1.
             _ => None,
         };
         if let Some(m) = m {

@@ -58,7 +58,10 @@ pub struct Campbell {
     pub speeds: Vec<f64>,
     /// Output torque at each speed [N m].
     pub torques: Vec<f64>,
-    /// Undamped natural frequency \[Hz\], `[speed][mode]`.
+    /// Natural frequency of the matched damped eigenvalue(s), `|lambda| / 2 pi` (the undamped
+    /// one when unmatched) \[Hz\], `[speed][mode]`: where the mode resonates, which under
+    /// non-proportional damping can lie far from the undamped frequency (for proportional
+    /// damping the two are equal).
     pub frequencies: Vec<Vec<f64>>,
     /// Damping ratio of the matched damped eigenvalue (the modal estimate when unmatched),
     /// `[speed][mode]`.
@@ -113,7 +116,14 @@ pub fn campbell(
                 m
             }
         };
-        frequencies.push(keep.iter().map(|&i| a.modes[i].frequency).collect());
+        frequencies.push(
+            keep.iter()
+                .map(|&i| {
+                    let m = &a.modes[i];
+                    m.damped.as_ref().map_or(m.frequency, |d| d.natural_frequency)
+                })
+                .collect(),
+        );
         damping_ratios.push(
             keep.iter()
                 .map(|&i| {
