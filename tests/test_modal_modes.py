@@ -186,3 +186,24 @@ def test_cli_modes_writes_table_energy_campbell_and_summary(tmp_path, capsys) ->
         crossings.append(len(json.loads((out / "modes.json").read_text())["campbell"]["crossings"]))
     assert crossings[0] < crossings[1]
     assert main(["modes", "--harmonics", "0", "--out", str(out)]) == 1
+
+
+def test_campbell_lines_are_where_the_damped_modes_resonate() -> None:
+    # Compliant paper preset: heavy non-proportional damping turns undamped mode 1 (846 Hz)
+    # into a damped pair at |lambda| / 2 pi = 1110 Hz; the frequency response of its M, K, C
+    # peaks there. The diagram followed the undamped 846 Hz.
+    scene = rvdyn.Scene.paper("rated").with_compliant_joints()
+    m = rvdyn.modes(scene)
+    cd = rvdyn.campbell(scene, [150.0, 160.0])
+    assert m.frequency[0] < 900.0 < m.damped_natural_frequency[0]
+    assert cd.frequency[0][0] == pytest.approx(m.damped_natural_frequency[0], rel=1e-12)
+    # An independent check of "where it resonates": the largest response of the carrier to a
+    # harmonic torque on it, |(K - w^2 M + i w C)^-1 e_c|, over 500-1500 Hz.
+    f = np.linspace(500.0, 1500.0, 2001)
+    e = np.zeros(len(m.dof_names))
+    e[0] = 1.0
+    amp = [abs(np.linalg.solve(m.stiffness - (2 * np.pi * x) ** 2 * m.mass + 2j * np.pi * x * m.damping, e)[0])
+           for x in f]
+    peak = f[int(np.argmax(amp))]
+    assert abs(peak - cd.frequency[0][0]) < 0.06 * cd.frequency[0][0]
+    assert abs(peak - m.frequency[0]) > 0.2 * m.frequency[0]
