@@ -58,3 +58,13 @@ def test_recorded_time_of_a_rigid_run_and_errors() -> None:
     rc = rvdyn.simulate(s.with_compliant_joints(), 2e-3, dt=1e-4, channels=["motion"])
     with pytest.raises(rvdyn.ParameterError, match="crank centres"):
         rvdyn.modes_at(rc, 1e-3)
+
+
+def test_a_state_far_from_equilibrium_says_so() -> None:
+    # The rated paper scene at rest in its kinematic pose: the tangent stiffness is
+    # indefinite along one mode (eigenvalue +1074 1/s), which came back as f = 0 and a NaN
+    # damping ratio without a word, and the residual of a state read 0.
+    with pytest.warns(RuntimeWarning, match="1 of 2 modes are unstable"):
+        m = rvdyn.modes(rvdyn.Scene.paper("rated"), state=(0.0, [0.0, 0.0], [0.0, 0.0]))
+    assert sum(m.extra["unstable"]) == 1 and np.isnan(m.residual)
+    assert np.max(m.eigenvalues.real) > 1000.0

@@ -64,7 +64,9 @@ class Modes:
     the linearised matrices (SI: kg, kg m^2, N/m, N m/rad, N s/m ...). time [s]: the time of
     the dynamic state linearised about (0 for an equilibrium); with machine shafts the
     coordinates end with ``"sun angle"``, ``"load angle"``, ``"motor angle"`` and the parts
-    with ``"shafts"``; about a moving state the last part is ``"rate-dependent"``."""
+    with ``"shafts"``; about a moving state the last part is ``"rate-dependent"``. residual:
+    the equilibrium's largest force residual relative to the load scale (NaN about a dynamic
+    state, which is no equilibrium)."""
 
     torque: float
     crank_angle: float
@@ -204,8 +206,17 @@ def modes(scene: Any, torque: float | None = None, crank_angle: float = 0.0, *,
             t_s, q, v = state
         except (TypeError, ValueError):
             raise ParameterError("state must be a (t, q, v) triple") from None
-        return Modes._from_core(_core.modes_state(scene.to_json(), _finite("state time", t_s, "s"),
-                                                  _as_list(q), _as_list(v)))
+        ms = Modes._from_core(_core.modes_state(scene.to_json(), _finite("state time", t_s, "s"),
+                                                _as_list(q), _as_list(v)))
+        unstable = int(sum(bool(u) for u in ms.extra["unstable"]))
+        if unstable:
+            # Off an equilibrium the tangent stiffness can be indefinite: such a mode grows.
+            warnings.warn(
+                f"modes: {unstable} of {len(ms)} modes are unstable about this state (the tangent "
+                "stiffness is indefinite along them: the state is far from an equilibrium); their "
+                "frequency is 0 and their damping ratio NaN, eigenvalues in .eigenvalues",
+                RuntimeWarning, stacklevel=2)
+        return ms
     t = _loaded_torque(scene, torque, "modes")
     psi = _finite("crank_angle", crank_angle, "rad")
     m = Modes._from_core(_core.modes(scene.to_json(), t, [psi])[0])

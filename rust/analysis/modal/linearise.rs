@@ -66,7 +66,8 @@ pub struct Equilibrium {
     pub unknowns: Vec<f64>,
     /// Full compliant-style coordinates at equilibrium.
     pub full: Vec<f64>,
-    /// Largest equilibrium residual relative to the load scale.
+    /// Largest equilibrium residual relative to the load scale (NaN about a dynamic state,
+    /// which is no equilibrium).
     pub residual: f64,
     /// Newton iterations of the equilibrium.
     pub iterations: usize,
@@ -425,7 +426,7 @@ impl Linearizer {
             torque: st.model.load.torque(t),
             full,
             unknowns,
-            residual: 0.0,
+            residual: f64::NAN,
             iterations: 0,
             split_error: 0.0,
             shaft_angles,

@@ -120,7 +120,9 @@ pub fn campbell(
             keep.iter()
                 .map(|&i| {
                     let m = &a.modes[i];
-                    m.damped.as_ref().map_or(m.frequency, |d| d.natural_frequency)
+                    m.damped
+                        .as_ref()
+                        .map_or(m.frequency, |d| d.natural_frequency)
                 })
                 .collect(),
         );
