@@ -2,7 +2,7 @@
 //! over crank angle, Campbell diagrams (`python/rvdyn/analysis/{spectrum,modes,campbell}.py`
 //! wrap these private functions).
 
-use crate::analysis::modal::{Linearizer, ModalPoint, campbell, modes_at, modes_at_state};
+use crate::analysis::modal::{Linearizer, ModalPoint, campbell, modes_at_state, modes_over};
 use crate::analysis::orders::{ExcitationOrder, campbell_crossings, scene_orders};
 use crate::dynamics::scene::Scene;
 use numpy::IntoPyArray;
@@ -170,10 +170,7 @@ fn modes<'py>(
     let scene = Scene::from_json(scene_json)?;
     let points = py.detach(|| -> crate::Result<Vec<ModalPoint>> {
         let mut lin = Linearizer::new(&scene)?;
-        crank_angles
-            .iter()
-            .map(|&a| modes_at(&mut lin, torque, a))
-            .collect()
+        modes_over(&mut lin, torque, &crank_angles)
     })?;
     points.iter().map(|p| point_dict(py, p)).collect()
 }

@@ -28,12 +28,165 @@ pub(super) struct DampedSet {
     /// All 2n refined eigenvalues, by increasing modulus.
     pub all: Vec<Complex<f64>>,
     pub unmatched: Vec<Complex<f64>>,
+    /// Each matched mode's two eigenvalues (a conjugate pair or two real roots), the hint
+    /// for the next point of a sweep.
+    pub ends: Vec<(usize, [Complex<f64>; 2])>,
 }
 
 struct Candidate {
     lambda: Complex<f64>,
     x: DVector<Complex<f64>>,
     oscillatory: bool,
+}
+
+/// Below this smallest MAC of the greedy matching, the matching is redone by continuation.
+const CONTINUATION_BELOW_MAC: f64 = 0.9;
+
+/// The damped pairs of a sweep's previous point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DampedTrack {
+    /// Each matched mode's two eigenvalues (a conjugate pair or two real roots) [1/s].
+    pub pairs: Vec<(usize, [Complex<f64>; 2])>,
+}
+
+/// Follow the damped eigenvalues of modes `modes` (two points each in `start`, consecutive)
+/// along the straight path from the system `(kt0, ct0)` to `(kt1, ct1)`, `beta` from 0 to 1
+/// with a first step `h0`: at each step the 2n eigenvalues are assigned one to one, nearest
+/// first, to the points extrapolated linearly in `beta`, and the step is halved until every
+/// point's eigenvalue is nearer than a third of the distance to any eigenvalue another mode
+/// holds (a pair that meets on the real axis and splits into two real roots stays with its
+/// mode). Used from zero damping (`ct0 = 0`, `start = +-i w_j`): the continuation in the
+/// damping, which defines which damped solution belongs to which undamped mode (a path in
+/// another parameter can end on a different assignment: eigenvalues of a non-symmetric
+/// problem can swap around an exceptional point). Returns each mode's two eigenvalues at
+/// `beta = 1`, or `None` when the step falls below 1e-7 (modes that stay together, such as
+/// equal frequencies) or after 5000 steps.
+fn track(
+    (kt0, ct0): (&DMatrix<f64>, &DMatrix<f64>),
+    (kt1, ct1): (&DMatrix<f64>, &DMatrix<f64>),
+    s: f64,
+    modes: &[usize],
+    start: Vec<Complex<f64>>,
+    h0: f64,
+    tol_im: f64,
+) -> Option<Vec<(usize, [Complex<f64>; 2])>> {
+    let (dk, dc) = (kt1 - kt0, ct1 - ct0);
+    let mut pts = start;
+    let mut prev: Option<(Vec<Complex<f64>>, f64)> = None;
+    let (mut alpha, mut h) = (0.0f64, h0);
+    let mut steps = 0;
+    while alpha < 1.0 {
+        steps += 1;
+        if steps > 5000 || h < 1e-7 {
+            return None;
+        }
+        let h_try = h.min(1.0 - alpha);
+        let b = alpha + h_try;
+        let e = if b == 1.0 {
+            state_eigenvalues(kt1, ct1, s).ok()?
+        } else {
+            state_eigenvalues(&(kt0 + &dk * b), &(ct0 + &dc * b), s).ok()?
+        };
+        let pred: Vec<Complex<f64>> = match &prev {
+            Some((p0, hp)) => pts
+                .iter()
+                .zip(p0)
+                .map(|(p, q)| p + (p - q) * (h_try / hp))
+                .collect(),
+            None => pts.clone(),
+        };
+        let Some(next) = assign(&pred, &e) else {
+            h = 0.5 * h_try;
+            continue;
+        };
+        prev = Some((std::mem::replace(&mut pts, next), h_try));
+        alpha += h_try;
+        h = (1.5 * h_try).min(0.1);
+    }
+    Some(pair_up(modes, &pts, tol_im))
+}
+
+/// The tracked points `pts` (two per mode, in the order of `modes`) as each mode's pair, with
+/// imaginary parts within `tol_im` of zero set to zero.
+fn pair_up(modes: &[usize], pts: &[Complex<f64>], tol_im: f64) -> Vec<(usize, [Complex<f64>; 2])> {
+    let snap = |v: Complex<f64>| {
+        if v.im.abs() <= tol_im {
+            Complex::new(v.re, 0.0)
+        } else {
+            v
+        }
+    };
+    modes
+        .iter()
+        .enumerate()
+        .map(|(m, &j)| (j, [snap(pts[2 * m]), snap(pts[2 * m + 1])]))
+        .collect()
+}
+
+/// One step of the tracking: the eigenvalues `e` assigned one to one, nearest first, to the
+/// points `pred` (two per mode, consecutive), or `None` unless each point's eigenvalue is
+/// nearer than a third of the distance to any eigenvalue another mode holds or none does
+/// (rigid-body roots).
+fn assign(pred: &[Complex<f64>], e: &[Complex<f64>]) -> Option<Vec<Complex<f64>>> {
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(pred.len() * e.len());
+    for (i, p) in pred.iter().enumerate() {
+        for (k, v) in e.iter().enumerate() {
+            pairs.push(((p - v).norm(), i, k));
+        }
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut of_point = vec![usize::MAX; pred.len()];
+    let mut taken = vec![usize::MAX; e.len()];
+    for (_, i, k) in pairs {
+        if of_point[i] == usize::MAX && taken[k] == usize::MAX {
+            of_point[i] = k;
+            taken[k] = i;
+        }
+    }
+    if of_point.contains(&usize::MAX) {
+        return None;
+    }
+    let clear = pred.iter().enumerate().all(|(i, p)| {
+        let d1 = (p - e[of_point[i]]).norm();
+        let d2 = e
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| taken[k] == usize::MAX || taken[k] / 2 != i / 2)
+            .map(|(_, v)| (p - v).norm())
+            .fold(f64::INFINITY, f64::min);
+        d1 <= d2 / 3.0
+    });
+    clear.then(|| of_point.iter().map(|&k| e[k]).collect())
+}
+
+/// The candidates' owners from the continuation's end points: a conjugate pair gives its
+/// upper eigenvalue's candidate, two real roots their two candidates (nearest, each once).
+/// `None` if an end point has no candidate of its kind left.
+fn owners_from_ends(
+    cands: &[Candidate],
+    ends: &[(usize, [Complex<f64>; 2])],
+    shapes: &[DVector<f64>],
+    mac: &dyn Fn(&Candidate, &DVector<f64>) -> f64,
+) -> Option<Vec<Option<(usize, f64)>>> {
+    let mut owner: Vec<Option<(usize, f64)>> = vec![None; cands.len()];
+    for &(j, [a, b]) in ends {
+        let wanted: Vec<Complex<f64>> = if a.im != 0.0 || b.im != 0.0 {
+            vec![if a.im >= b.im { a } else { b }]
+        } else {
+            vec![a, b]
+        };
+        for w in wanted {
+            let oscillatory = w.im != 0.0;
+            let ci = cands
+                .iter()
+                .enumerate()
+                .filter(|(ci, c)| c.oscillatory == oscillatory && owner[*ci].is_none())
+                .min_by(|x, y| (x.1.lambda - w).norm().total_cmp(&(y.1.lambda - w).norm()))?
+                .0;
+            owner[ci] = Some((j, mac(&cands[ci], &shapes[j])));
+        }
+    }
+    Some(owner)
 }
 
 /// Damped eigenvalues of the reduced system, matched to the undamped reduced shapes
@@ -43,6 +196,7 @@ pub(super) fn damped_modes(
     ct: &DMatrix<f64>,
     lam_max: f64,
     shapes: &[DVector<f64>],
+    hint: Option<&DampedTrack>,
 ) -> Result<DampedSet> {
     let n = kt.nrows();
     let s = if lam_max > 0.0 {
@@ -50,39 +204,7 @@ pub(super) fn damped_modes(
     } else {
         ct.norm().max(1.0)
     };
-    let mut a = DMatrix::<f64>::zeros(2 * n, 2 * n);
-    for i in 0..n {
-        a[(i, n + i)] = s;
-        for j in 0..n {
-            a[(n + i, j)] = -kt[(i, j)] / s;
-            a[(n + i, n + j)] = -ct[(i, j)];
-        }
-    }
-    // The QR iteration stops at a relative subdiagonal of 1e-10 (about half the sweeps of
-    // machine precision); every eigenvalue is then polished on the pencil to round-off. If it
-    // does not converge (QR without exceptional shifts can cycle), retry on the same spectrum
-    // with a different velocity scaling, which changes the iteration's path.
-    let mut raw: Option<Vec<Complex<f64>>> = None;
-    for (attempt, factor) in [1.0, 1.37, 0.61].into_iter().enumerate() {
-        let mut m = a.clone();
-        if attempt > 0 {
-            for i in 0..n {
-                m[(i, n + i)] = s * factor;
-                for j in 0..n {
-                    m[(n + i, j)] = -kt[(i, j)] / (s * factor);
-                }
-            }
-        }
-        if let Some(schur) = Schur::try_new(m, 1e-10, 1000 * (2 * n).max(10)) {
-            raw = Some(schur.complex_eigenvalues().iter().copied().collect());
-            break;
-        }
-    }
-    let raw = raw.ok_or_else(|| {
-        RvdynError::Convergence(
-            "the Schur iteration for the damped eigenvalues did not converge".into(),
-        )
-    })?;
+    let raw = state_eigenvalues(kt, ct, s)?;
     let scale = raw.iter().fold(s, |m, l| m.max(l.norm()));
     let tol_im = 1e-8 * scale;
 
@@ -149,6 +271,46 @@ pub(super) fn damped_modes(
         }
     }
 
+    // The greedy MAC matching can pair a damped solution with the wrong undamped mode under
+    // heavy non-proportional damping (the shapes turn). When any match is uncertain, follow
+    // every flexible mode from i w_j as the damping grows from 0 to C instead.
+    let min_mac = owner.iter().flatten().fold(1.0f64, |a, (_, m)| a.min(*m));
+    if min_mac < CONTINUATION_BELOW_MAC {
+        let omegas: Vec<(usize, f64)> = shapes
+            .iter()
+            .enumerate()
+            .filter_map(|(j, y)| {
+                let w2 = y.dot(&(kt * y));
+                (w2 > 1e-10 * lam_max).then(|| (j, w2.sqrt()))
+            })
+            .collect();
+        // A sweep's previous point (the same modes at a nearby torque or crank angle) is
+        // one tracking step away; the continuation from zero damping otherwise.
+        let flexible: Vec<usize> = omegas.iter().map(|&(j, _)| j).collect();
+        // A sweep's previous point (the same modes at a nearby torque or crank angle): when
+        // its pairs are each clearly nearest to two of these eigenvalues, the continuation
+        // would end there too; otherwise it is run.
+        let from_hint = hint.and_then(|h| {
+            let modes: Vec<usize> = h.pairs.iter().map(|&(j, _)| j).collect();
+            if modes != flexible {
+                return None;
+            }
+            let pts: Vec<Complex<f64>> = h.pairs.iter().flat_map(|&(_, p)| p).collect();
+            assign(&pts, &raw).map(|next| pair_up(&modes, &next, tol_im))
+        });
+        let ends = from_hint.or_else(|| {
+            let start = omegas
+                .iter()
+                .flat_map(|&(_, w)| [Complex::new(0.0, w), Complex::new(0.0, -w)])
+                .collect();
+            let zero = DMatrix::<f64>::zeros(n, n);
+            track((kt, &zero), (kt, ct), s, &flexible, start, 0.02, tol_im)
+        });
+        if let Some(o) = ends.and_then(|e| owners_from_ends(&cands, &e, shapes, &mac)) {
+            owner = o;
+        }
+    }
+
     let mut matched = Vec::new();
     let mut unmatched = Vec::new();
     for j in 0..shapes.len() {
@@ -211,10 +373,64 @@ pub(super) fn damped_modes(
         }
     }
     all.sort_by(|x, y| x.norm().total_cmp(&y.norm()).then(y.im.total_cmp(&x.im)));
+    let mut ends = Vec::with_capacity(matched.len());
+    for (j, _) in &matched {
+        let mine: Vec<&Candidate> = owner
+            .iter()
+            .zip(&cands)
+            .filter_map(|(o, c)| o.filter(|(jj, _)| jj == j).map(|_| c))
+            .collect();
+        match mine.as_slice() {
+            [c] if c.oscillatory => ends.push((*j, [c.lambda, c.lambda.conj()])),
+            [a, b] => ends.push((*j, [a.lambda, b.lambda])),
+            _ => {}
+        }
+    }
     Ok(DampedSet {
         matched,
         all,
         unmatched,
+        ends,
+    })
+}
+
+/// The 2n eigenvalues of `y'' + ct y' + kt y = 0` from the real Schur form of the state matrix
+/// `[[0, s I], [-kt/s, -ct]]` (`s` a velocity scale; the eigenvalues do not depend on it),
+/// unpolished.
+fn state_eigenvalues(kt: &DMatrix<f64>, ct: &DMatrix<f64>, s: f64) -> Result<Vec<Complex<f64>>> {
+    let n = kt.nrows();
+    let mut a = DMatrix::<f64>::zeros(2 * n, 2 * n);
+    for i in 0..n {
+        a[(i, n + i)] = s;
+        for j in 0..n {
+            a[(n + i, j)] = -kt[(i, j)] / s;
+            a[(n + i, n + j)] = -ct[(i, j)];
+        }
+    }
+    // The QR iteration stops at a relative subdiagonal of 1e-10 (about half the sweeps of
+    // machine precision); every eigenvalue is then polished on the pencil to round-off. If it
+    // does not converge (QR without exceptional shifts can cycle), retry on the same spectrum
+    // with a different velocity scaling, which changes the iteration's path.
+    let mut raw: Option<Vec<Complex<f64>>> = None;
+    for (attempt, factor) in [1.0, 1.37, 0.61].into_iter().enumerate() {
+        let mut m = a.clone();
+        if attempt > 0 {
+            for i in 0..n {
+                m[(i, n + i)] = s * factor;
+                for j in 0..n {
+                    m[(n + i, j)] = -kt[(i, j)] / (s * factor);
+                }
+            }
+        }
+        if let Some(schur) = Schur::try_new(m, 1e-10, 1000 * (2 * n).max(10)) {
+            raw = Some(schur.complex_eigenvalues().iter().copied().collect());
+            break;
+        }
+    }
+    raw.ok_or_else(|| {
+        RvdynError::Convergence(
+            "the Schur iteration for the damped eigenvalues did not converge".into(),
+        )
     })
 }
 

@@ -33,8 +33,9 @@ use crate::error::{Result, RvdynError};
 use nalgebra::{Complex, DMatrix, DVector, SymmetricEigen};
 use std::f64::consts::TAU;
 
+pub use damped::DampedTrack;
 pub use linearise::{Equilibrium, Linearizer};
-pub use sweep::{Campbell, ModalPoint, campbell, modes_at, modes_at_state};
+pub use sweep::{Campbell, ModalPoint, campbell, modes_at, modes_at_state, modes_over};
 
 /// One named contribution to the stiffness matrix (a contact family or a bearing family).
 #[derive(Debug, Clone, PartialEq)]
@@ -126,6 +127,9 @@ pub struct ModalAnalysis {
     pub eigenvalues: Vec<Complex<f64>>,
     /// Eigenvalues (upper half plane) that matched no undamped mode.
     pub unmatched: Vec<Complex<f64>>,
+    /// Each matched mode's two eigenvalues (a conjugate pair or two real roots) with the
+    /// reduced matrices: pass it to [`modal_analysis_near`] for the next point of a sweep.
+    pub damped_track: DampedTrack,
 }
 
 impl ModalAnalysis {
@@ -180,6 +184,18 @@ impl ModalAnalysis {
 /// (naming it) or a mass matrix that is not positive definite (naming the coordinate where the
 /// Cholesky factorisation fails); `ConvergenceError` if an eigenvalue iteration fails.
 pub fn modal_analysis(sys: &LinearSystem) -> Result<ModalAnalysis> {
+    modal_analysis_near(sys, None)
+}
+
+/// [`modal_analysis`] at a point of a sweep: `previous` holds the previous point's
+/// [`ModalAnalysis::damped_track`], from which the damped eigenvalues are matched to the modes
+/// when each previous pair is clearly nearest to two of the new eigenvalues (the step is
+/// small), instead of the continuation from zero damping that an uncertain matching otherwise
+/// takes; docs/model.md, "Modal analysis").
+pub fn modal_analysis_near(
+    sys: &LinearSystem,
+    previous: Option<&DampedTrack>,
+) -> Result<ModalAnalysis> {
     let n = sys.dof_names.len();
     check_inputs(sys)?;
     let names = &sys.dof_names;
@@ -265,7 +281,7 @@ pub fn modal_analysis(sys: &LinearSystem) -> Result<ModalAnalysis> {
         reduced_shapes.push(y);
     }
 
-    let damped = damped::damped_modes(&kt, &ct, lam_max, &reduced_shapes)?;
+    let damped = damped::damped_modes(&kt, &ct, lam_max, &reduced_shapes, previous)?;
     for (mode_index, dm) in damped.matched {
         let md = &mut modes[mode_index];
         if md.rigid_body {
@@ -296,6 +312,7 @@ pub fn modal_analysis(sys: &LinearSystem) -> Result<ModalAnalysis> {
         damping_asymmetry,
         eigenvalues: damped.all,
         unmatched: damped.unmatched,
+        damped_track: DampedTrack { pairs: damped.ends },
     })
 }
 

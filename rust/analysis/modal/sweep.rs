@@ -1,7 +1,9 @@
 //! Modes of a reducer scene at an operating point, over a mesh period, and over the input
 //! speed (Campbell diagram).
 
-use crate::analysis::modal::{Equilibrium, Linearizer, ModalAnalysis, modal_analysis};
+use crate::analysis::modal::{
+    DampedTrack, Equilibrium, Linearizer, ModalAnalysis, modal_analysis_near,
+};
 use crate::analysis::orders::{Crossing, ExcitationOrder, campbell_crossings, scene_orders};
 use crate::dynamics::scene::Scene;
 use crate::error::{Result, RvdynError};
@@ -25,11 +27,32 @@ pub struct ModalPoint {
 /// `torque` [N m].
 pub fn modes_at(lin: &mut Linearizer, torque: f64, crank_angle: f64) -> Result<ModalPoint> {
     let (sys, eq) = lin.linearise(torque, crank_angle)?;
-    point(sys, eq)
+    point(sys, eq, None)
 }
 
-fn point(sys: crate::analysis::modal::LinearSystem, eq: Equilibrium) -> Result<ModalPoint> {
-    let analysis = modal_analysis(&sys)?;
+/// [`modes_at`] at each of `crank_angles` \[rad\] in turn (equilibria warm-started, damped
+/// modes matched by tracking from the previous angle where unambiguous).
+pub fn modes_over(
+    lin: &mut Linearizer,
+    torque: f64,
+    crank_angles: &[f64],
+) -> Result<Vec<ModalPoint>> {
+    let mut out: Vec<ModalPoint> = Vec::with_capacity(crank_angles.len());
+    for &a in crank_angles {
+        let (sys, eq) = lin.linearise(torque, a)?;
+        let previous = out.last().map(|p| &p.analysis.damped_track);
+        let p = point(sys, eq, previous)?;
+        out.push(p);
+    }
+    Ok(out)
+}
+
+fn point(
+    sys: crate::analysis::modal::LinearSystem,
+    eq: Equilibrium,
+    previous: Option<&DampedTrack>,
+) -> Result<ModalPoint> {
+    let analysis = modal_analysis_near(&sys, previous)?;
     let n = sys.dof_names.len();
     let mut k = nalgebra::DMatrix::<f64>::zeros(n, n);
     for p in &sys.stiffness {
@@ -102,9 +125,11 @@ pub fn campbell(
     let mut frequencies = Vec::with_capacity(speeds.len());
     let mut damping_ratios = Vec::with_capacity(speeds.len());
     let mut modes: Option<Vec<usize>> = None;
+    let mut previous: Option<DampedTrack> = None;
     for &t in torques {
         let (sys, _) = lin.linearise(t, crank_angle)?;
-        let a = modal_analysis(&sys)?;
+        let a = modal_analysis_near(&sys, previous.as_ref())?;
+        previous = Some(a.damped_track.clone());
         let keep = match &modes {
             Some(m) => m.clone(),
             None => {
@@ -161,5 +186,5 @@ pub fn modes_at_state(
 ) -> Result<ModalPoint> {
     let eq = lin.state_point(scene, t, q, v)?;
     let (sys, eq) = lin.linearise_about(eq)?;
-    point(sys, eq)
+    point(sys, eq, None)
 }
