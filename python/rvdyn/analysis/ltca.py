@@ -588,7 +588,10 @@ def torque_twist(scene: Scene, rated_torque: float | None = None, crank_angle: f
 def running_friction(scene: Scene, torque: float | None = None, points: int | None = None, *,
                      start: float = 0.0, window: bool = False) -> dict[str, np.ndarray | float]:
     """Quasi-static running sweeps with the scene's friction at ``points`` crank angles per
-    mesh period (default: 24, or two per tooth-mesh cycle of an ISO 6336 mesh if that is more),
+    mesh period (default: 24, or eight per tooth-mesh cycle of an ISO 6336 mesh or of tooth
+    friction if that is more: the tooth sliding reverses at the pitch point, and two per cycle
+    fold its harmonics onto the mean, 0.9175-0.9233 with the start angle on the physical preset
+    at mu 0.05 against 0.9214-0.9218 at eight),
     over one mesh period from ``start`` [rad] or (``window=True``) over the whole window after
     which everything repeats (``TransmissionError.window``): every contact slides as in the
     running reducer, the input driving against ``+torque`` (forward) and ``-torque``
@@ -598,14 +601,15 @@ def running_friction(scene: Scene, torque: float | None = None, points: int | No
     sweep divided by that with friction, ``mean(T_in,0) / mean(T_in)`` (docs/model.md, "Friction
     in the LTCA"). The frictionless sweep's work is the output work up to the elastic energy's
     change and the quadrature of the input torque's steps at the ISO mesh's zone changes; both
-    cancel in the quotient (1 without friction; the physical preset at mu 0.05 gives 0.918-0.922
-    from 24 to 336 angles, where ``T / (i mean(T_in))`` gave 0.906-0.925)."""
+    cancel in the quotient (1 without friction; the physical preset at mu 0.05 gives 0.9218 at
+    the default 336 angles, where ``T / (i mean(T_in))`` gave 0.906-0.925 over 24-336).
+    Fewer than two angles per tooth-mesh cycle warn."""
     sc = _scene(scene)
     t = abs(_rated(sc, torque))
     solver = _core.LtcaSolver(sc._compiled, 1e-12)
     period = float(solver.mesh_period)
     needed = _tooth_mesh_angles(sc, period)
-    n = max(24, needed) if points is None else _whole("points", points, 1, MAX_POINTS)
+    n = max(24, 4 * needed) if points is None else _whole("points", points, 1, MAX_POINTS)
     if not isinstance(window, bool):
         raise ParameterError(f"window must be True or False, got {window!r}")
     periods = _window_periods(float(solver.te_window), period) if window else 1
