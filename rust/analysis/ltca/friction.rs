@@ -51,6 +51,12 @@ pub struct FrictionLaws {
     pub bearings: Option<[PalmgrenFriction; 2]>,
     /// `(sin, cos)` of the first stage's pressure angle.
     pressure: [f64; 2],
+    /// The scene's steady input speed [rad/s] (0 for a torque drive).
+    input_speed: f64,
+    /// Crank angle per second of the motion the friction acts in: the running reducer's in a
+    /// running sweep, 0 in the held-input twist loop. It sets the bearings' speed-dependent
+    /// Palmgren `M0` (the dynamic models use their bearings' speeds).
+    crank_rate: f64,
 }
 
 impl FrictionLaws {
@@ -78,6 +84,11 @@ impl FrictionLaws {
             _ => None,
         };
         Self {
+            input_speed: match scene.drive {
+                crate::dynamics::scene::Drive::Speed { speed, .. } => speed.abs(),
+                _ => 0.0,
+            },
+            crank_rate: 0.0,
             pin: f.pin * f.pin_rolling.unwrap_or(1.0),
             mesh: if scene.stage1.is_some() { f.mesh } else { 0.0 },
             bearings,
@@ -247,16 +258,16 @@ pub(crate) fn friction_forces(
             if st.crank_bearing.is_some()
                 && let Some(fb) = cs.crank_bearing_force.get(i)
             {
-                let mt =
-                    crank.torque_unchecked(0.0, fb[0].hypot(fb[1])) * rel(dir, ci + 2, CARRIER);
+                let w = laws.crank_rate * (dir[ci + 2] - dir[CARRIER]).abs();
+                let mt = crank.torque_unchecked(w, fb[0].hypot(fb[1])) * rel(dir, ci + 2, CARRIER);
                 qf[ci + 2] -= mt;
                 qf[CARRIER] += mt;
             }
             for k in 0..nd {
                 let dk = st.disc_index(k);
                 if let Some(fb) = cs.eccentric_bearing_force.get(i * nd + k) {
-                    let mt =
-                        ecc.torque_unchecked(0.0, fb[0].hypot(fb[1])) * rel(dir, ci + 2, dk + 2);
+                    let w = laws.crank_rate * (dir[ci + 2] - dir[dk + 2]).abs();
+                    let mt = ecc.torque_unchecked(w, fb[0].hypot(fb[1])) * rel(dir, ci + 2, dk + 2);
                     qf[ci + 2] -= mt;
                     qf[dk + 2] += mt;
                 }
@@ -543,6 +554,14 @@ impl Ltca {
         // The load acts against positive carrier rotation and the carrier turns by
         // `-psi / zc`: the input drives it against a positive torque with psi decreasing.
         let drive = if torque < 0.0 { 1.0 } else { -1.0 };
+        // The running reducer at the scene's input speed: crank angle per second.
+        let mut laws = laws.clone();
+        laws.crank_rate = if self.statics.model.mesh.is_some() {
+            laws.input_speed / self.statics.held_input(1.0).abs()
+        } else {
+            laws.input_speed
+        };
+        let laws = &laws;
         let mut out = Vec::with_capacity(crank_angles.len());
         for &psi in crank_angles {
             let (q, _) = self.solve_unknowns(torque, psi)?;
