@@ -149,6 +149,17 @@ def test_running_sweep_over_the_whole_window() -> None:
         running_friction(scene, RATED, window=1)  # type: ignore[arg-type]
 
 
+def test_running_friction_at_light_and_zero_torque() -> None:
+    # At 100 N m the frictional Newton stalled at 1.9e-9 of the load (a few hundred ulps of
+    # the forces) and hit its iteration cap with "friction coefficients may be too large"; at
+    # 0 N m the efficiency was the quotient of two round-off works (1.013).
+    rough = rvdyn.Scene.physical("rated", friction={"pin": 0.05, "mesh": 0.05})
+    light = running_friction(rough, 100.0, 84)
+    assert 0.85 < float(light["efficiency_forward"]) < 0.95
+    with pytest.raises(rvdyn.ParameterError, match="needs a torque"):
+        running_friction(rough, 0.0)
+
+
 def test_default_grid_resolves_the_tooth_sliding_reversal() -> None:
     # Eight angles per tooth-mesh cycle by default (336 on the physical preset): at two (84)
     # the efficiency moved between 0.9175 and 0.9233 with the start angle, because the tooth

@@ -603,9 +603,13 @@ def running_friction(scene: Scene, torque: float | None = None, points: int | No
     change and the quadrature of the input torque's steps at the ISO mesh's zone changes; both
     cancel in the quotient (1 without friction; the physical preset at mu 0.05 gives 0.9218 at
     the default 336 angles, where ``T / (i mean(T_in))`` gave 0.906-0.925 over 24-336).
-    Fewer than two angles per tooth-mesh cycle warn."""
+    Fewer than two angles per tooth-mesh cycle warn; a zero torque is a ``ParameterError``."""
     sc = _scene(scene)
     t = abs(_rated(sc, torque))
+    if t == 0.0:
+        # Both input works are round-off then: their quotient was any number (1.013 seen).
+        raise ParameterError("running_friction needs a torque: at 0 N m no work flows through the "
+                             "reducer and the efficiency is undefined; give the torque [N m]")
     solver = _core.LtcaSolver(sc._compiled, 1e-12)
     period = float(solver.mesh_period)
     needed = _tooth_mesh_angles(sc, period)

@@ -415,7 +415,7 @@ impl Ltca {
             .fold(rp, |m, (x, l)| m.max((x * l).abs()));
         let floor = 4.0 * f64::EPSILON * self.k_ref * size;
         let done = (self.options.tolerance * load).max(floor);
-        let stalled_ok = (1e-9 * load).max(10.0 * floor);
+        let stalled_ok = (1e-9 * load).max(100.0 * floor);
         let norm = |r: &[f64]| {
             r.iter()
                 .zip(&scale)
@@ -429,6 +429,10 @@ impl Ltca {
         let mut it = 0;
         while rmax > done {
             if it >= self.options.max_iterations.min(60) {
+                // Stalled within a few hundred ulps of the forces (light loads): converged.
+                if rmax <= stalled_ok {
+                    break;
+                }
                 return Err(not_converged(psi, torque, rmax / load.max(1.0), it));
             }
             it += 1;
@@ -591,7 +595,8 @@ fn not_converged(psi: f64, torque: f64, res: f64, it: usize) -> RvdynError {
     RvdynError::Convergence(format!(
         "no equilibrium with friction at crank angle {psi:.6} rad and torque {torque:.6e} N m \
          (residual {res:.3e} of the load after {it} iterations): the friction coefficients may \
-         be too large for a sliding equilibrium; reduce them or the torque"
+         be too large for a sliding equilibrium, or the torque too small to seat the bodies in \
+         their bearing clearances; reduce the coefficients or raise the torque"
     ))
 }
 
