@@ -103,3 +103,15 @@ def test_the_default_integrator_of_a_scene_with_rollers_is_accurate() -> None:
     with pytest.warns(RuntimeWarning, match="steps per stiffness ramp"):
         simulate(scene, 1e-3, "generalized-alpha", dt=1e-4, progress=False)
     assert simulate(Scene.paper("rated"), 1e-3, progress=False).options["integrator"] == "generalized-alpha"
+
+
+def test_friction_inputs_that_cannot_be_meant_are_caught() -> None:
+    # A bearing-oil viscosity typed in cSt (68) was taken as 68 m^2/s: efficiency 0.36.
+    with pytest.raises(rvdyn.SceneError, match="68e-6 m\\^2/s"):
+        rvdyn.Scene.physical("rated", friction={"bearing": {"f0": 3.0, "f1": 3e-4, "viscosity": 68.0}})
+    # A regularisation speed not small against the pins' sliding speed (0.36 m/s at the paper's
+    # speed) made the friction partly viscous: efficiency 0.968 at 1 m/s against 0.921.
+    base = rvdyn.Scene.physical("rated", initial="steady", **{"drive.start": "step"})
+    with pytest.warns(RuntimeWarning, match="regularisation_speed = 0.1 m/s is not small"):
+        rvdyn.simulate(base.replace(friction={"pin": 0.05, "regularisation_speed": 0.1}), 2e-3)
+    rvdyn.simulate(base.replace(friction={"pin": 0.05}), 2e-3)  # the default: no warning

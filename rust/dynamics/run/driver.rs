@@ -272,9 +272,39 @@ fn checked_run<M: ReducerModel>(
             w
         }
     };
+    let mut warnings = warnings;
+    warnings.extend(friction_warnings(scene));
     let mut rec = run(sys, options, control)?;
     rec.warnings = warnings;
     Ok(rec)
+}
+
+/// A regularisation speed that is not small against the sliding speeds makes the regularised
+/// Coulomb law partly viscous: the friction forces, and the losses, come out too small (on the
+/// physical preset at mu 0.05, efficiency 0.968 at 1 m/s and 0.996 at 10 m/s against 0.921).
+/// The scale is the pins' sliding speed `w_out (rp - rrp)` at the steady input speed (the
+/// teeth slide about as fast); above a tenth of it the run warns.
+pub fn friction_warnings(scene: &Scene) -> Vec<String> {
+    let f = &scene.friction;
+    let (crate::dynamics::scene::Drive::Speed { speed, .. }, true) =
+        (scene.drive, f.pin > 0.0 || f.mesh > 0.0)
+    else {
+        return Vec::new();
+    };
+    let sliding = speed.abs() / scene.ratio().abs()
+        * (scene.cycloid.pin_circle_radius - scene.cycloid.pin_radius);
+    if sliding > 0.0 && f.regularisation_speed > 0.1 * sliding {
+        vec![format!(
+            "friction.regularisation_speed = {} m/s is not small against the pins' sliding \
+             speed, about {sliding:.3e} m/s at this input speed: the regularised friction acts \
+             partly as a viscous damper and the losses come out too small; use at most {:.1e} \
+             m/s",
+            f.regularisation_speed,
+            0.1 * sliding
+        )]
+    } else {
+        Vec::new()
+    }
 }
 
 /// Steps per pin-mesh period below which a fixed step is reported: at 8 the pin forces of the

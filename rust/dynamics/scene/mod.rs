@@ -573,6 +573,9 @@ pub struct Friction {
     pub bearing: Option<BearingFriction>,
 }
 
+/// Largest accepted bearing-oil kinematic viscosity [m^2/s] (10 000 cSt).
+pub const MAX_OIL_VISCOSITY: f64 = 1e-2;
+
 fn default_regularisation_speed() -> f64 {
     1e-3
 }
@@ -623,6 +626,16 @@ impl Friction {
                 if !(x.is_finite() && x >= 0.0) {
                     return bad(format!("friction.bearing.{n} must be >= 0, got {x}"));
                 }
+            }
+            // 1e-2 m^2/s is 10 000 cSt, thicker than any bearing oil at its running
+            // temperature (ISO VG 1000 has 1000 cSt at 40 C): a larger value is a unit mistake.
+            if b.viscosity > MAX_OIL_VISCOSITY {
+                return bad(format!(
+                    "friction.bearing.viscosity is a kinematic viscosity in m^2/s, got {} m^2/s \
+                     ({:.0} cSt, more than any bearing oil); 68 cSt is 68e-6 m^2/s",
+                    b.viscosity,
+                    b.viscosity * 1e6
+                ));
             }
         }
         Ok(())
