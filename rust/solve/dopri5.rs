@@ -271,8 +271,9 @@ impl Dopri5 {
                      {h:.2e} s because this scene's fastest mode has an eigenvalue of about \
                      {lambda:.2e} 1/s ({:.2e} Hz); an explicit method would need more than {:.0e} \
                      steps per simulated second. Use integrator=\"generalized-alpha\" (implicit, \
-                     stable at any step), or make the scene less stiff (softer bearings or a \
-                     heavier disc)",
+                     stable at any step), or make the scene less stiff (softer bearings, a \
+                     heavier disc, or with friction a larger friction.regularisation_speed: \
+                     friction near zero sliding speed acts as a damper of mu N / v_reg)",
                     st.t,
                     lambda / (2.0 * std::f64::consts::PI),
                     1.0 / h
