@@ -108,3 +108,35 @@ def test_usage_errors_and_help():
     assert r.returncode == 2 and "invalid choice" in r.stderr
     r = run("--version")
     assert r.returncode == 0 and "rvdyn" in r.stdout
+
+
+def test_command_line_mistakes_are_caught_before_the_work(tmp_path):
+    # An outside review of the CLI: each of these worked badly.
+    # A negative number in scientific notation was read as an option ("expected one argument").
+    r = run("analyze", "--preset", "paper", "--torque", "-4.39e4", "--angles", "6", "--loop-points", "9",
+            "--out", str(tmp_path / "neg"))
+    assert r.returncode == 0, r.stderr
+    assert json.loads((tmp_path / "neg" / "summary.json").read_text())["torque_Nm"] == pytest.approx(-4.39e4)
+    # --angles 1 failed only after the LTCA, with an API argument's name.
+    r = run("analyze", "--angles", "1", "--out", str(tmp_path / "a"))
+    assert r.returncode == 1 and "--angles must be at least 2" in r.stderr
+    assert not (tmp_path / "a").exists()
+    # --out "" wrote into the current folder (analyze) or failed late (modes).
+    for cmd in ("analyze", "modes"):
+        r = run(cmd, "--out", "", cwd=tmp_path)
+        assert r.returncode == 2 and "must not be empty" in r.stderr
+    # A missing study spec: one prefix, not two.
+    r = run("study", str(tmp_path / "nonexist.toml"))
+    assert r.returncode == 1 and r.stderr.count("ParameterError") == 1, r.stderr
+
+
+def test_warnings_are_one_line_each_and_once(tmp_path):
+    # They came with the source path and code line, in the middle of the progress line, and
+    # the contact-pressure warning twice.
+    r = run("analyze", "--preset", "paper", "--torque", "2e5", "--angles", "6", "--loop-points", "9",
+            "--out", str(tmp_path))
+    assert r.returncode == 0, r.stderr
+    warn = [line for line in r.stderr.splitlines() if "warning:" in line]
+    assert warn and all(line.startswith("rvdyn analyze: warning: ") for line in warn)
+    assert len(warn) == len(set(warn))
+    assert "cli.py" not in r.stderr and ".py:" not in r.stderr

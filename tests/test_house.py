@@ -236,6 +236,10 @@ def test_scene_sizes_that_leave_no_reducer_are_scene_errors() -> None:
                           ({"pin_errors.position": [[1.0, 0.0]] * 24}, "pin_errors.position")]:
         with pytest.raises(rvdyn.SceneError, match=match):
             s.replace(**change)
+    # A negative pin radius is named as such (the modification check blamed d_rp = 0).
+    with pytest.raises(rvdyn.RvdynError, match="pin_radius") as info:
+        s.replace(**{"cycloid.pin_radius": -0.01})
+    assert "modification" not in str(info.value)
     # Real sizes pass (and the geometry tests' 2 mm shift).
     s.replace(**{"cycloid.d_rp": -2e-3, "cycloid.d_delta": 1e-4, "pin_errors.radius": [5e-6] * 24})
     # Options of the wrong kind are refused rather than read loosely.

@@ -207,3 +207,16 @@ def test_campbell_lines_are_where_the_damped_modes_resonate() -> None:
     peak = f[int(np.argmax(amp))]
     assert abs(peak - cd.frequency[0][0]) < 0.06 * cd.frequency[0][0]
     assert abs(peak - m.frequency[0]) > 0.2 * m.frequency[0]
+
+
+def test_campbell_travel_speeds_follow_the_reducers_ratio() -> None:
+    # The km/h column and the default speed range assumed the paper's ratio 57 for any scene:
+    # a single-stage reducer (ratio -23) read 2.5 times too slow.
+    single = rvdyn.Scene.paper("rated").replace(stage1=None)
+    cd = rvdyn.campbell(single, points=3, harmonics=2)
+    assert abs(single.ratio) == pytest.approx(23.0)
+    # The paper's travel range 3.3-5.5 km/h at this ratio.
+    assert cd.speeds[0] == pytest.approx(math.radians(8328.0) * 23.0 / 57.0, rel=1e-12)
+    for row in cd.table():
+        assert row["travel_speed_kmh"] == pytest.approx(row["input_speed_rad_s"] / 23.0 * 57.0 * 3.3
+                                                        / math.radians(8328.0), rel=1e-12)

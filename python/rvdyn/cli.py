@@ -23,7 +23,9 @@ import importlib
 import json
 import math
 import os
+import re
 import sys
+import warnings
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
@@ -484,9 +486,17 @@ def build_parser(commands: Sequence[Command] = COMMANDS) -> argparse.ArgumentPar
     sub.required = True
     for cmd in commands:
         p = sub.add_parser(cmd.name, help=cmd.help, description=cmd.help)
+        # argparse (before Python 3.13) reads "-4.39e4" as an option, not a negative number.
+        p._negative_number_matcher = _NEGATIVE_NUMBER
         cmd.add_arguments(p)
         p.set_defaults(_run=cmd.run)
     return parser
+
+
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+
+#: Whether a command's progress line (written with "\r", no newline yet) is open on stderr.
+_PROGRESS_OPEN = [False]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -494,8 +504,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     from .errors import RvdynError
 
     args = build_parser().parse_args(argv)
+    seen: set[str] = set()
+
+    def show(message: Warning | str, category: type[Warning], *_: object, **__: object) -> None:
+        # One line each, once, on a line of its own (a progress line may be open).
+        text = f"rvdyn {args.command}: warning: {message}"
+        if text not in seen:
+            seen.add(text)
+            print(f"\n{text}" if _PROGRESS_OPEN[0] else text, file=sys.stderr)
+
     try:
-        code = int(args._run(args))
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", RuntimeWarning)
+            warnings.showwarning = show
+            code = int(args._run(args))
         sys.stdout.flush()  # a full or closed stdout fails here, inside the handlers below
         return code
     except RvdynError as exc:

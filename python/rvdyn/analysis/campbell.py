@@ -24,6 +24,8 @@ __all__ = ["CampbellDiagram", "Crossing", "campbell", "travel_to_input_speed", "
 #: The paper's travel speed range [km/h] ([P] section 4.1).
 PAPER_TRAVEL_RANGE_KMH = (3.3, 5.5)
 _PAPER_INPUT_AT_3_3 = math.radians(8328.0)  # rad/s at 3.3 km/h
+#: The paper's reducer ratio [-].
+PAPER_RATIO = 57.0
 
 
 def travel_to_input_speed(kmh: float | np.ndarray) -> Any:
@@ -41,11 +43,14 @@ class Crossing:
     frequency: float
     order: ExcitationOrder
     mode: int
+    #: The reducer's ratio (input over output speed) [-].
+    ratio: float = PAPER_RATIO
 
     @property
     def travel_speed_kmh(self) -> float:
-        """The paper's travel speed [km/h] at this input speed."""
-        return self.speed * 3.3 / _PAPER_INPUT_AT_3_3
+        """Travel speed [km/h] of the paper's drive (its wheel) with this reducer at this input
+        speed: the output speed ``speed / |ratio|`` times the paper's wheel radius."""
+        return self.speed / abs(self.ratio) * PAPER_RATIO * 3.3 / _PAPER_INPUT_AT_3_3
 
 
 @dataclass
@@ -107,7 +112,8 @@ def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, 
              torque: float | None = None, crank_angle: float = 0.0, harmonics: int = 8,
              frequency_range: tuple[float, float] | None = None, points: int = 200) -> CampbellDiagram:
     """Campbell diagram of ``scene`` over the input ``speeds`` [rad/s] (increasing; default
-    ``points`` speeds over the paper's travel range 3.3-5.5 km/h, 145.4-242.3 rad/s).
+    ``points`` speeds over the paper's travel range 3.3-5.5 km/h at this reducer's ratio,
+    145.4-242.3 rad/s at the paper's 57).
 
     The modes at each speed are those about the equilibrium at ``crank_angle`` [rad] under the
     output torque of that speed: constant ``torque`` [N m], or ``power`` [W] transmitted
@@ -123,7 +129,9 @@ def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, 
     n_harmonics = _whole("harmonics", harmonics, 1, MAX_HARMONICS)
     if speeds is None:
         n = _whole("points", points, 2, 1_000_000)
-        lo, hi = (float(v) for v in travel_to_input_speed(np.array(PAPER_TRAVEL_RANGE_KMH)))
+        # The paper's travel range at this reducer's ratio (the same wheel speeds).
+        scale = abs(float(scene.ratio)) / PAPER_RATIO
+        lo, hi = (scale * float(v) for v in travel_to_input_speed(np.array(PAPER_TRAVEL_RANGE_KMH)))
         speeds = np.linspace(lo, hi, n)
     w = np.asarray(speeds, dtype=float).ravel()
     if power is not None and torque is not None:
@@ -145,6 +153,7 @@ def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, 
     d = _core.campbell_diagram(scene.to_json(), [float(x) for x in w], [float(x) for x in t],
                                _finite("crank_angle", crank_angle, "rad"), n_harmonics, frequency_range)
     orders = [ExcitationOrder(n, int(h), float(o), lab) for n, h, o, lab in d["orders"]]
-    crossings = [Crossing(float(s), float(f), orders[int(o)], int(m)) for s, f, o, m in d["crossings"]]
+    crossings = [Crossing(float(s), float(f), orders[int(o)], int(m), float(scene.ratio))
+                 for s, f, o, m in d["crossings"]]
     return CampbellDiagram(w, t, np.asarray(d["frequency"]), np.asarray(d["damping_ratio"]), list(d["modes"]),
                            orders, crossings, float(crank_angle))

@@ -25,12 +25,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "for the TE, eight per tooth-mesh cycle of an ISO mesh, at least 90)")
     p.add_argument("--loop-points", type=int, default=201, metavar="N",
                    help="points of the torque-twist loop (default 201)")
-    p.add_argument("--out", default="rvdyn-out", metavar="DIR", help="output folder (default rvdyn-out)")
+    from ..cli import _folder
+
+    p.add_argument("--out", default="rvdyn-out", metavar="DIR", type=_folder,
+                   help="output folder (default rvdyn-out)")
 
 
 def _progress(done: int, total: int) -> None:
+    from ..cli import _PROGRESS_OPEN
+
     print(f"\r  LTCA: {done}/{total} crank angles", end="" if done < total else "\n",
           file=sys.stderr, flush=True)
+    _PROGRESS_OPEN[0] = done < total
 
 
 def run(args: argparse.Namespace) -> int:
@@ -45,6 +51,15 @@ def run(args: argparse.Namespace) -> int:
         scene = Scene.load(args.scene)
     else:
         scene = Scene.physical("rated") if args.preset == "physical" else Scene.paper("rated")
+    # The options' own limits, before any work (they used to fail after the LTCA).
+    from ..errors import ParameterError
+
+    if args.angles is not None and args.angles < 2:
+        raise ParameterError(f"--angles must be at least 2 crank angles per mesh period, got {args.angles}")
+    if args.loop_points < 8:
+        raise ParameterError(f"--loop-points must be at least 8, got {args.loop_points}")
+    if args.torque is None and scene["load.kind"] != "constant":
+        raise ParameterError(f"the scene's load is {scene['load.kind']!r}, not a constant torque: give --torque N_M")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"rvdyn analyze: scene {scene['name'] or '(unnamed)'}, writing to {out}/", file=sys.stderr)
@@ -112,8 +127,10 @@ def run(args: argparse.Namespace) -> int:
         f"the +-rated points, lost motion within +-3 % of it)",
         f"- equilibrium: torque balance <= {summary['torque_balance_max']:.1e}, residual <= "
         f"{summary['residual_max']:.1e} (relative)",
-        *([f"- friction (pins {fr['pin']:g}, teeth {fr['mesh']:g}): in the torque-twist loop only; the "
-           "load distribution, TE and input torque above are frictionless"] if (fr := scene.to_dict()["friction"])
+        *([f"- friction (pins {fr['pin']:g}, teeth {fr['mesh']:g}"
+           + (f", bearings Palmgren f0 {fr['bearing']['f0']:g}, f1 {fr['bearing']['f1']:g}" if fr.get("bearing") else "")
+           + "): in the torque-twist loop only; the load distribution, TE and input torque above are "
+           "frictionless"] if (fr := scene.to_dict()["friction"])
           and (fr["pin"] > 0 or fr["mesh"] > 0 or fr.get("bearing")) else []),
         "",
         "Conventions and formulas: docs/model.md, \"Quasi-static analysis\".",

@@ -356,12 +356,15 @@ def add_cli_arguments(p: Any) -> None:
                    help="Campbell diagram at constant power [W] (default: constant torque)")
     p.add_argument("--speeds", type=float, nargs=2, default=None, metavar=("LO", "HI"),
                    help="input speed range [deg/s] of the Campbell diagram (default: the paper's "
-                   "3.3-5.5 km/h, 8328-13880 deg/s)")
+                   "travel range 3.3-5.5 km/h at the scene's ratio, 8328-13880 deg/s at 57)")
     p.add_argument("--points", type=int, default=200, help="speeds in the Campbell diagram (default 200)")
     p.add_argument("--harmonics", type=int, default=8,
                    help="pin-pass and sun-mesh harmonics in the Campbell diagram (default 8: the ISO "
                    "mesh stiffness is a rectangular wave with strong higher harmonics)")
-    p.add_argument("--out", default="rvdyn-out", metavar="DIR", help="output folder (default rvdyn-out)")
+    from ..cli import _folder
+
+    p.add_argument("--out", default="rvdyn-out", metavar="DIR", type=_folder,
+                   help="output folder (default rvdyn-out)")
 
 
 def run_cli(args: Any) -> int:

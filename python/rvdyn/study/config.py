@@ -130,6 +130,8 @@ def load_spec(path: str | Path) -> dict[str, Any]:
     :class:`rvdyn.ParameterError` naming the spec."""
     try:
         return _load_spec(path)
+    except ParameterError:
+        raise  # already names the spec or its field
     except (TypeError, ValueError, KeyError) as exc:
         raise ParameterError(f"study spec {str(path)!r}: {type(exc).__name__}: {exc}") from None
 

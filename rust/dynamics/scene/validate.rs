@@ -76,7 +76,8 @@ impl Scene {
                 ("d_rrp", p.d_rrp, p.d_rrp.abs()),
                 ("d_delta", p.d_delta, (p.d_delta * rp).abs()),
             ] {
-                if size > rrp {
+                // A pin radius that is itself invalid gets the geometry's own message below.
+                if rrp > 0.0 && size > rrp {
                     return err(format!(
                         "disc {k}: the modification {n} = {v} moves the profile by {size:.4e} m, \
                          more than the pin radius {rrp} m; profile modifications are tens of \
