@@ -293,3 +293,15 @@ def test_te_harmonics_converge_and_their_uncertainty_bounds_the_aliasing() -> No
     fine = {h.harmonic: h for h in transmission_error(scene, RATED, 2688, window=False).harmonics("forward", 400)}
     for k in (23, 42, 84):
         assert fine[k].amplitude == pytest.approx(ref[k].amplitude, rel=1e-2), k
+
+
+def test_a_failing_light_load_is_named_as_the_unloaded_te() -> None:
+    # At 1 N m with the modified profile the unloaded curves' light load (1e-3 N m) found no
+    # equilibrium, and the message named 1e-3 N m as "the torque" and said to reduce it.
+    from rvdyn.analysis import transmission_error
+
+    s = rvdyn.Scene.physical("rated", **{"cycloid.d_rrp": 2e-5, "cycloid.d_rp": -2e-5})
+    with pytest.raises(rvdyn.ConvergenceError, match="unloaded TE, at the light load 0.001 N m"):
+        transmission_error(s, 1.0)
+    te = transmission_error(s, 1.0, light=0.01)
+    assert all(np.isfinite(v) for v in te.peak_to_peak().values())

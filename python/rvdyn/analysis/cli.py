@@ -23,6 +23,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--angles", type=int, default=None, metavar="N",
                    help="crank angles per mesh period (default 90 for the load distribution; "
                         "for the TE, eight per tooth-mesh cycle of an ISO mesh, at least 90)")
+    p.add_argument("--light", type=float, default=None, metavar="NM",
+                   help="light load [N m] of the unloaded TE (default 1e-6 of the torque, at least "
+                   "1e-3 N m); raise it if the unloaded TE finds no equilibrium")
     p.add_argument("--loop-points", type=int, default=201, metavar="N",
                    help="points of the torque-twist loop (default 201)")
     from ..cli import _folder
@@ -69,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     angles = period * np.arange(n) / n
     res = ltca(scene, args.torque, angles, progress=_progress, chunk=max(n // 10, 1))
     print("  TE both directions ...", file=sys.stderr)
-    te = transmission_error(scene, args.torque, args.angles)
+    te = transmission_error(scene, args.torque, args.angles, light=args.light)
     print("  torque-twist loop ...", file=sys.stderr)
     loop = torque_twist(scene, args.torque, 0.0, args.loop_points)
     files = [

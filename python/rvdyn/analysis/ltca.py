@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 import numpy as np
 
 from .. import _core
-from ..errors import ParameterError
+from ..errors import ConvergenceError, ParameterError
 from ..plotting import _whole
 from ..scene import Scene
 
@@ -535,7 +535,19 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
     # points), where a floating body settles reliably above the forces' round-off.
     lt = max(1e-6 * t, min(1e-3, 0.01 * t)) if light is None else abs(_float("light", light, "N m"))
     periods = _window_periods(float(solver.te_window), period) if window else 1
-    d = solver.transmission_error(t, lt, int(points), _float("start", start, "rad"), False, periods)
+    try:
+        d = solver.transmission_error(t, lt, int(points), _float("start", start, "rad"), False, periods)
+    except ConvergenceError as exc:
+        import re
+
+        m = re.search(r"output torque (-?[0-9.eE+-]+) N m", str(exc))
+        if m is None or not math.isclose(abs(float(m.group(1))), lt, rel_tol=1e-5):
+            raise
+        # The unloaded curves' light load, not the torque given: say so, and what to change.
+        raise ConvergenceError(
+            f"the unloaded TE, at the light load {lt:.3g} N m (`light`), found no equilibrium: at "
+            f"such a load bodies can float in their bearing clearances. Give a larger `light` "
+            f"(`rvdyn analyze --light`), e.g. {max(10 * lt, 1.0):g} N m. ({exc})") from exc
     te = TransmissionError(crank_angle=d["crank_angle"], period=float(d["period"]),
                            forward=d["forward"], reverse=d["reverse"],
                            unloaded_forward=d["unloaded_forward"],
