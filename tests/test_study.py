@@ -484,3 +484,16 @@ def test_statistics_of_a_numpy_table_match_the_dataframe() -> None:
     crit = [Criterion("y", max=0.0)]
     assert rvdyn.study.yield_rate(a, crit) == rvdyn.study.yield_rate(df, crit)
     assert rvdyn.study.describe(a, n_resamples=100) == rvdyn.study.describe(df, n_resamples=100)
+
+
+def test_empty_assembly_error_lists_take_their_shape_from_the_scene() -> None:
+    # A tolerance on errors.crank_eccentricity needed an undocumented shape=(3,): the empty
+    # list means "no errors", zeros of (cranks,); disc holes (cranks x discs, 2).
+    from rvdyn.study.spec import expand
+
+    s = rvdyn.Scene.physical("rated")
+    lay = expand(s, [{"path": "errors.crank_eccentricity", "tol": 5e-6},
+                     {"path": "errors.disc_holes", "tol": 5e-6}, {"path": "errors.carrier_seats", "tol": 5e-6}])
+    cols = [v.column for v in lay.variables]
+    assert cols[:3] == [f"errors.crank_eccentricity.{i}" for i in range(3)]
+    assert len(cols) == 3 + 3 * 2 * 2 + 3 * 2

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -37,9 +37,13 @@ DISTRIBUTIONS = ("normal", "uniform")
 
 # List fields that are empty in a scene until set, with the shape they take (as scene paths or
 # numbers): an empty list means "no errors", i.e. zeros of this shape.
-_EMPTY_LIST_SHAPES: dict[str, tuple[str | int, ...]] = {
-    "pin_errors.radius": ("cycloid.pins",),
-    "pin_errors.position": ("cycloid.pins", 2),
+_EMPTY_LIST_SHAPES: dict[str, Callable[[Scene], tuple[int, ...]]] = {
+    "pin_errors.radius": lambda s: (int(s["cycloid.pins"]),),
+    "pin_errors.position": lambda s: (int(s["cycloid.pins"]), 2),
+    "errors.crank_eccentricity": lambda s: (int(s["cranks"]),),
+    "errors.crank_phase": lambda s: (int(s["cranks"]),),
+    "errors.disc_holes": lambda s: (int(s["cranks"]) * len(s["discs"]), 2),
+    "errors.carrier_seats": lambda s: (int(s["cranks"]), 2),
 }
 
 
@@ -220,7 +224,7 @@ def _resolve_shape(scene: Scene, path: str, tol: Tolerance, value: Any) -> tuple
         rule = _EMPTY_LIST_SHAPES.get(path)
         if rule is None:
             raise ParameterError(f"tolerance {path!r}: the scene's list is empty; give its shape=(...)")
-        return tuple(int(scene[s]) if isinstance(s, str) else s for s in rule)
+        return rule(scene)
     return None
 
 
