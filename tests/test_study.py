@@ -462,6 +462,13 @@ def test_spec_mistakes_are_one_line_errors_and_dotted_changes_change_one_field(t
     with pytest.raises(rvdyn.ParameterError, match="unknown integrator"):
         rvdyn.study.kernels.DynamicKernel(t_end=0.01, integrator="bogus")
     assert main(["study", spec('[kernel]\nname = "dynamic"\nt_end = 0.01\nintegrator = "bogus"')]) == 1
+    # A misspelled kernel option named Python's __init__; now the known options, and the
+    # refused spec leaves no empty output folder.
+    with pytest.raises(rvdyn.ParameterError, match=r"unknown options \['tend'\]; known: \['t_end'"):
+        rvdyn.study.kernels.get_kernel("dynamic", tend=0.1)
+    out = os.path.join(tmp_path, "never")
+    assert main(["study", spec(f'[kernel]\nname = "dynamic"\ntend = 0.01\n[output]\ndir = "{out}"')]) == 1
+    assert not os.path.exists(out)
 
 
 def scene_named_metrics(scene: rvdyn.Scene) -> dict[str, float]:

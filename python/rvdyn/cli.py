@@ -437,8 +437,7 @@ def _run_study(args: argparse.Namespace) -> int:
     if res["samples"] and res["failed"] == res["samples"]:
         # Nothing to analyse: a wrong kernel option fails every sample, and a job script
         # should see it.
-        print("rvdyn study: every sample failed; the first error is in the table's 'error' column",
-              file=sys.stderr)
+        print(f"rvdyn study: every sample failed; the first: {res.get('first_error')}", file=sys.stderr)
         return 1
     return 0
 

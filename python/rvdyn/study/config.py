@@ -194,12 +194,18 @@ def run_spec(path: str | Path, out: str | Path | None = None, samples: int | Non
     outdir = Path(out) if out is not None else args["output"]
     sampler = args["samples"] if samples is None else type(args["samples"])(as_sampler(samples).n)
     runner = _runner(args["runner_spec"])
+    created = not outdir.exists()
     outdir.mkdir(parents=True, exist_ok=True)
     try:
         table = run(args["scene"], args["kernel"], args["tolerances"], sampler, seed=args["seed"], runner=runner,
                     out=outdir / "results.parquet", correlations=args["correlations"], criteria=args["criteria"],
                     kernel_options=args["kernel_options"], chunk_size=args["chunk_size"],
                     batch_size=args["batch_size"], progress=progress)
+    except BaseException:
+        # A spec refused before any sample ran leaves no empty output folder behind.
+        if created and outdir.is_dir() and not any(outdir.iterdir()):
+            outdir.rmdir()
+        raise
     finally:
         if not isinstance(runner, str):
             cluster = getattr(runner, "cluster", None)
@@ -207,7 +213,9 @@ def run_spec(path: str | Path, out: str | Path | None = None, samples: int | Non
             if cluster is not None:
                 cluster.close()
     summary = stats.describe(table)
-    result: dict[str, Any] = {"samples": int(len(table)), "failed": int((table["error"] != "").sum()),
+    errors = table["error"][table["error"] != ""]
+    result: dict[str, Any] = {"samples": int(len(table)), "failed": int(len(errors)),
+                              "first_error": str(next(iter(errors))) if len(errors) else None,
                               "metrics": {m: {k: (v.__dict__ if isinstance(v, stats.Interval) else v)
                                               for k, v in e.items()} for m, e in summary.items()}}
     if args["criteria"]:

@@ -226,8 +226,16 @@ def get_kernel(kernel: Any, **options: Any) -> Any:
     if isinstance(kernel, str):
         if kernel not in KERNELS:
             raise ParameterError(f"unknown kernel {kernel!r}; known: {sorted(KERNELS)}")
+        import inspect
+
+        factory = KERNELS[kernel]
+        params = inspect.signature(factory).parameters
+        known = [n for n in params if n != "self"]
+        unknown = sorted(set(options) - set(known))
+        if unknown and not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
+            raise ParameterError(f"kernel {kernel!r}: unknown options {unknown}; known: {known}")
         try:
-            return KERNELS[kernel](**options)
+            return factory(**options)
         except TypeError as exc:
             raise ParameterError(f"kernel {kernel!r}: {exc}") from None
     if options:
