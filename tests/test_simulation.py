@@ -374,3 +374,14 @@ def test_classical_pin_forces_match_the_dynamic_model_at_a_slow_linear_run() -> 
     assert np.max(np.abs(f - classical)[away]) < 0.01 * f.max()
     with pytest.raises(rvdyn.ParameterError):
         g.classical_pin_forces(float("nan"), 0.0)
+
+
+def test_scene_files_toml_errors_in_one_line_and_any_case_suffix(tmp_path) -> None:
+    # A TOML mistake printed a five-line excerpt with a caret; a ".TOML" file was read as JSON.
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "x"\n[cycloid]\npins = 2x4\n')
+    with pytest.raises(rvdyn.SceneError, match="line 3, column 8: string values must be quoted") as info:
+        Scene.load(bad)
+    assert "\n" not in str(info.value)
+    upper = Scene.paper("rated").save(tmp_path / "s.TOML")
+    assert upper.read_text().lstrip().startswith(("name", "[", "#")) and Scene.load(upper) == Scene.paper("rated")

@@ -187,22 +187,22 @@ class Scene:
         return self._compiled.to_toml()
 
     def save(self, path: str | Path) -> Path:
-        """Write the scene to ``path``: TOML for ``.toml``, JSON otherwise. Returns the path."""
+        """Write the scene to ``path``: TOML for ``.toml`` (any case), JSON otherwise. Returns the path."""
         p = Path(path)
-        text = self.to_toml() if p.suffix == ".toml" else self.to_json()
+        text = self.to_toml() if p.suffix.lower() == ".toml" else self.to_json()
         p.write_text(text, encoding="utf-8")
         return p
 
     @classmethod
     def load(cls, path: str | Path) -> Scene:
-        """Read a scene written by :meth:`save` (TOML for ``.toml``, JSON otherwise)."""
+        """Read a scene written by :meth:`save` (TOML for ``.toml`` in any case, JSON otherwise)."""
         p = Path(path)
         try:
             text = p.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             raise SceneError(f"cannot read scene file {str(p)!r}: {exc}") from exc
         try:
-            return cls.from_toml(text) if p.suffix == ".toml" else cls.from_json(text)
+            return cls.from_toml(text) if p.suffix.lower() == ".toml" else cls.from_json(text)
         except SceneError as exc:
             raise SceneError(f"scene file {str(p)!r}: {exc}") from exc
 

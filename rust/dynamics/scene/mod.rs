@@ -815,6 +815,22 @@ pub struct Scene {
     pub initial: Initial,
 }
 
+/// A parser's multi-line report (position, source excerpt with a caret, message) as one line:
+/// the first line and the message.
+fn one_line(e: &dyn std::fmt::Display) -> String {
+    let text = e.to_string();
+    let lines: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('|') && !l.contains(" | "))
+        .collect();
+    match lines.as_slice() {
+        [] => text,
+        [one] => (*one).to_string(),
+        [first, .., last] => format!("{first}: {last}"),
+    }
+}
+
 impl Scene {
     /// The same reducer with rigid joints, for what only the rigid model's geometry, laws and
     /// masses are wanted from (the LTCA's laws, the mass properties): without the assembly
@@ -862,8 +878,9 @@ impl Scene {
 
     /// Parse a scene from TOML text.
     pub fn from_toml(text: &str) -> Result<Self> {
-        let v: serde_json::Value = toml::from_str(text)
-            .map_err(|e| RvdynError::Scene(format!("scene text is not valid TOML: {e}")))?;
+        let v: serde_json::Value = toml::from_str(text).map_err(|e| {
+            RvdynError::Scene(format!("scene text is not valid TOML: {}", one_line(&e)))
+        })?;
         Self::from_value(&v)
     }
 
