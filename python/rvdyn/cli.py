@@ -318,6 +318,9 @@ def _folder(text: str) -> str:
 #: (relative to the carrier) from 20 % of the run on, and one takes 0.103 s at the paper's
 #: input speed (8328 deg/s x 24/57 = 3506 deg/s); 0.2 s leaves 0.16 s, more than one.
 PAPER_MIN_T_END = 0.2
+#: Longest ``rvdyn paper --t-end`` [s]: it records every 1e-4 s (the paper's figures), so 20 s
+#: is 200 000 samples of every channel, about 0.1 GB.
+PAPER_MAX_T_END = 20.0
 
 
 def _paper_t_end(text: str) -> float:
@@ -332,6 +335,11 @@ def _paper_t_end(text: str) -> float:
         raise argparse.ArgumentTypeError(
             f"must be at least {PAPER_MIN_T_END} s (the summary averages whole crank "
             f"revolutions after the first 20 % of the run), got {text}"
+        )
+    if t > PAPER_MAX_T_END:
+        raise argparse.ArgumentTypeError(
+            f"must be at most {PAPER_MAX_T_END:g} s (every 1e-4 s is recorded for the paper's "
+            f"figures; use rvdyn.simulate with a longer record_interval for long runs), got {text}"
         )
     return t
 
