@@ -55,7 +55,7 @@ def _rated(scene: Scene, torque: float | None) -> float:
     load = scene["load"]
     if isinstance(load, dict) and load.get("kind") == "constant":
         return float(load["torque"])
-    raise ParameterError("give the torque [N m]: the scene's load is not a constant torque")
+    raise ParameterError("give the torque [N m] (--torque in rvdyn analyze): the scene's load is not a constant torque")
 
 
 @dataclass(frozen=True)

@@ -179,7 +179,8 @@ def _loaded_torque(scene: Any, torque: float | None, what: str) -> float:
         raise ParameterError(
             f"{what} about an equilibrium need a load: at 0 N m the contacts carry nothing and have no "
             "stiffness (a Hertz law's tangent is zero at zero load), so every frequency would be "
-            "round-off; give a torque (e.g. the rated 43921.3 N m) or, for modes, state=(t, q, v) of a run")
+            "round-off; give a torque (e.g. the rated 43921.3 N m; --torque in rvdyn modes) or, for modes, "
+            "state=(t, q, v) of a run")
     return t
 
 
