@@ -220,3 +220,19 @@ def test_campbell_travel_speeds_follow_the_reducers_ratio() -> None:
     for row in cd.table():
         assert row["travel_speed_kmh"] == pytest.approx(row["input_speed_rad_s"] / 23.0 * 57.0 * 3.3
                                                         / math.radians(8328.0), rel=1e-12)
+
+
+def test_sweeps_follow_the_modes_and_agree_with_single_points() -> None:
+    # A sweep matches each point's damped solutions by extrapolating the previous two points'
+    # pairs (falling back to the continuation in the damping when that is ambiguous). Where
+    # the matching is unambiguous, as on the physical preset (stiffness-proportional
+    # damping), it equals a separate modes() at every point; on the compliant paper preset at
+    # its first point (measured 3e-12 and 0).
+    w = np.linspace(145.351, 242.252, 30)
+    for scene, every in ((rvdyn.Scene.physical("rated"), True),
+                         (rvdyn.Scene.paper("rated").with_compliant_joints(), False)):
+        cd = rvdyn.campbell(scene, w, power=112e3, crank_angle=0.1, harmonics=2)
+        for k in (range(0, 30, 7) if every else [0]):
+            m = rvdyn.modes(scene, torque=cd.torques[k], crank_angle=0.1)
+            expected = np.where(m.matched, m.damped_natural_frequency, m.frequency)
+            np.testing.assert_allclose(cd.frequency[k], expected, rtol=1e-9)

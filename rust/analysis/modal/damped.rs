@@ -47,12 +47,27 @@ const CONTINUATION_BELOW_MAC: f64 = 0.9;
 pub struct DampedTrack {
     /// Each matched mode's two eigenvalues (a conjugate pair or two real roots) [1/s].
     pub pairs: Vec<(usize, [Complex<f64>; 2])>,
+    /// The same at the point before (empty at a sweep's first point): with it the next
+    /// point's pairs are extrapolated.
+    pub before: Vec<(usize, [Complex<f64>; 2])>,
+}
+
+/// A pair's sum and squared difference: smooth where the pair meets on the real axis.
+fn pair_invariants([a, b]: [Complex<f64>; 2]) -> [Complex<f64>; 2] {
+    [a + b, (a - b) * (a - b)]
+}
+
+/// The pair with the sum and squared difference `[s, d]`.
+fn pair_from_invariants([s, d]: [Complex<f64>; 2]) -> [Complex<f64>; 2] {
+    let r = d.sqrt();
+    [(s + r) * 0.5, (s - r) * 0.5]
 }
 
 /// Follow the damped eigenvalues of modes `modes` (two points each in `start`, consecutive)
 /// along the straight path from the system `(kt0, ct0)` to `(kt1, ct1)`, `beta` from 0 to 1
 /// with a first step `h0`: at each step the 2n eigenvalues are assigned one to one, nearest
-/// first, to the points extrapolated linearly in `beta`, and the step is halved until every
+/// first, to the points predicted from each pair's sum and squared difference extrapolated in
+/// `beta` (smooth where the pair meets on the real axis), and the step is halved until every
 /// point's eigenvalue is nearer than a third of the distance to any eigenvalue another mode
 /// holds (a pair that meets on the real axis and splits into two real roots stays with its
 /// mode). Used from zero damping (`ct0 = 0`, `start = +-i w_j`): the continuation in the
@@ -73,6 +88,7 @@ fn track(
     let (dk, dc) = (kt1 - kt0, ct1 - ct0);
     let mut pts = start;
     let mut prev: Option<(Vec<Complex<f64>>, f64)> = None;
+    let mut prev2: Option<(Vec<Complex<f64>>, f64)> = None;
     let (mut alpha, mut h) = (0.0f64, h0);
     let mut steps = 0;
     while alpha < 1.0 {
@@ -87,18 +103,42 @@ fn track(
         } else {
             state_eigenvalues(&(kt0 + &dk * b), &(ct0 + &dc * b), s).ok()?
         };
-        let pred: Vec<Complex<f64>> = match &prev {
-            Some((p0, hp)) => pts
-                .iter()
-                .zip(p0)
-                .map(|(p, q)| p + (p - q) * (h_try / hp))
-                .collect(),
-            None => pts.clone(),
+        // Each mode's pair through its sum and squared difference, which stay smooth where
+        // the pair meets on the real axis and splits (the roots themselves move there like a
+        // square root): extrapolated quadratically through the last three steps (linearly
+        // from two), then the roots `(s +- sqrt(d)) / 2`.
+        let invariants = |p: &[Complex<f64>]| -> Vec<[Complex<f64>; 2]> {
+            p.chunks(2)
+                .map(|ab| pair_invariants([ab[0], ab[1]]))
+                .collect()
         };
+        let now = invariants(&pts);
+        let guess: Vec<[Complex<f64>; 2]> = match (&prev, &prev2) {
+            (Some((p1, h1)), Some((p2, h2))) => {
+                let (a1, a2) = (invariants(p1), invariants(p2));
+                let (t0, t1, t) = (-(h1 + h2), -h1, h_try);
+                let l0 = (t - t1) * t / ((t0 - t1) * t0);
+                let l1 = (t - t0) * t / ((t1 - t0) * t1);
+                let l2 = (t - t0) * (t - t1) / (t0 * t1);
+                now.iter()
+                    .zip(&a1)
+                    .zip(&a2)
+                    .map(|((c, b), a)| [0, 1].map(|i| a[i] * l0 + b[i] * l1 + c[i] * l2))
+                    .collect()
+            }
+            (Some((p1, h1)), None) => now
+                .iter()
+                .zip(invariants(p1))
+                .map(|(c, b)| [0, 1].map(|i| c[i] + (c[i] - b[i]) * (h_try / h1)))
+                .collect(),
+            _ => now,
+        };
+        let pred: Vec<Complex<f64>> = guess.into_iter().flat_map(pair_from_invariants).collect();
         let Some(next) = assign(&pred, &e) else {
             h = 0.5 * h_try;
             continue;
         };
+        prev2 = prev.take();
         prev = Some((std::mem::replace(&mut pts, next), h_try));
         alpha += h_try;
         h = (1.5 * h_try).min(0.1);
@@ -295,7 +335,20 @@ pub(super) fn damped_modes(
             if modes != flexible {
                 return None;
             }
-            let pts: Vec<Complex<f64>> = h.pairs.iter().flat_map(|&(_, p)| p).collect();
+            // Extrapolated from the two points before when the sweep has them.
+            let same = h.before.iter().map(|&(j, _)| j).eq(modes.iter().copied());
+            let pts: Vec<Complex<f64>> = if same {
+                h.pairs
+                    .iter()
+                    .zip(&h.before)
+                    .flat_map(|(&(_, p), &(_, q))| {
+                        let (a, b) = (pair_invariants(p), pair_invariants(q));
+                        pair_from_invariants([0, 1].map(|i| a[i] * 2.0 - b[i]))
+                    })
+                    .collect()
+            } else {
+                h.pairs.iter().flat_map(|&(_, p)| p).collect()
+            };
             assign(&pts, &raw).map(|next| pair_up(&modes, &next, tol_im))
         });
         let ends = from_hint.or_else(|| {

@@ -312,7 +312,10 @@ pub fn modal_analysis_near(
         damping_asymmetry,
         eigenvalues: damped.all,
         unmatched: damped.unmatched,
-        damped_track: DampedTrack { pairs: damped.ends },
+        damped_track: DampedTrack {
+            pairs: damped.ends,
+            before: previous.map(|p| p.pairs.clone()).unwrap_or_default(),
+        },
     })
 }
 
