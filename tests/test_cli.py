@@ -140,3 +140,6 @@ def test_warnings_are_one_line_each_and_once(tmp_path):
     assert warn and all(line.startswith("rvdyn analyze: warning: ") for line in warn)
     assert len(warn) == len(set(warn))
     assert "cli.py" not in r.stderr and ".py:" not in r.stderr
+    # In the command's option names.
+    r = run("analyze", "--angles", "30", "--loop-points", "9", "--out", str(tmp_path / "b"))
+    assert "use --angles >= 84" in r.stderr and "use points" not in r.stderr, r.stderr

@@ -502,6 +502,12 @@ def build_parser(commands: Sequence[Command] = COMMANDS) -> argparse.ArgumentPar
 
 _NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 
+#: Library argument names in warnings, as the commands' options.
+_OPTION_NAMES: dict[str, tuple[tuple[str, str], ...]] = {
+    "analyze": (("use points >=", "use --angles >="), ("points per period", "--angles per period"),
+                ("(`light` for the unloaded curves)", "(--light for the unloaded curves)")),
+}
+
 #: Whether a command's progress line (written with "\r", no newline yet) is open on stderr.
 _PROGRESS_OPEN = [False]
 
@@ -514,8 +520,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     seen: set[str] = set()
 
     def show(message: Warning | str, category: type[Warning], *_: object, **__: object) -> None:
-        # One line each, once, on a line of its own (a progress line may be open).
-        text = f"rvdyn {args.command}: warning: {message}"
+        # One line each, once, on a line of its own (a progress line may be open), in the
+        # command's own option names where the library names its arguments.
+        words = str(message)
+        for api, option in _OPTION_NAMES.get(args.command, ()):
+            words = words.replace(api, option)
+        text = f"rvdyn {args.command}: warning: {words}"
         if text not in seen:
             seen.add(text)
             print(f"\n{text}" if _PROGRESS_OPEN[0] else text, file=sys.stderr)
