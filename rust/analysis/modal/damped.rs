@@ -269,7 +269,7 @@ pub(super) fn damped_modes(
             .get(first_flexible + k)
             .map(|y| y.map(|v| Complex::new(v, 0.0)))
             .unwrap_or_else(|| generic_start(n));
-        let (lambda, x) = refine(&kc, &cc, *l, start, scale)?;
+        let (lambda, x) = refine(&kc, &cc, *l, start, scale, reach(&raw, *l))?;
         cands.push(Candidate {
             lambda,
             x,
@@ -277,7 +277,7 @@ pub(super) fn damped_modes(
         });
     }
     for l in &real {
-        let (lambda, x) = refine(&kc, &cc, *l, generic_start(n), scale)?;
+        let (lambda, x) = refine(&kc, &cc, *l, generic_start(n), scale, reach(&raw, *l))?;
         cands.push(Candidate {
             lambda: Complex::new(lambda.re, 0.0),
             x,
@@ -506,10 +506,20 @@ fn refine(
     l: Complex<f64>,
     start: DVector<Complex<f64>>,
     scale: f64,
+    reach: f64,
 ) -> Result<(Complex<f64>, DVector<Complex<f64>>)> {
     let (mut lambda, mut x) = polish(kc, cc, l, start, scale)?;
+    // The Rayleigh quotient can jump to a neighbouring eigenvalue (heavy, non-proportional
+    // damping): a polished value must stay nearer its Schur value than any other Schur value
+    // is, or the Schur value (accurate to about 1e-10) is kept.
+    if (lambda - l).norm() > reach {
+        return Ok((l, x));
+    }
     for _ in 0..5 {
         let (l2, x2) = polish(kc, cc, lambda, x.clone(), scale)?;
+        if (l2 - l).norm() > reach {
+            break;
+        }
         let moved = (l2 - lambda).norm();
         lambda = l2;
         x = x2;
@@ -518,6 +528,23 @@ fn refine(
         }
     }
     Ok((lambda, x))
+}
+
+/// A third of the distance from the Schur value `l` to the nearest other one of `raw` (the
+/// whole spectrum): how far polishing may move it.
+fn reach(raw: &[Complex<f64>], l: Complex<f64>) -> f64 {
+    // The nearest is `l` itself (a real one stored with its imaginary round-off set to 0).
+    let (mut first, mut second) = (f64::INFINITY, f64::INFINITY);
+    for v in raw {
+        let d = (v - l).norm();
+        if d < first {
+            second = first;
+            first = d;
+        } else if d < second {
+            second = d;
+        }
+    }
+    second / 3.0
 }
 
 /// Inverse iteration at a shift next to `l`, then the pencil's Rayleigh quotient. `kc`, `cc`:

@@ -691,7 +691,8 @@ impl Linearizer {
         Ok(k)
     }
 
-    /// `C = -dQ/dv` by forward differences (exact for rate-linear damping laws).
+    /// `C = -dQ/dv` by forward differences of 1 um/s (exact for rate-linear damping laws while
+    /// the contacts stay pushing).
     fn damping_matrix(&self, eq: &Equilibrium) -> Result<DMatrix<f64>> {
         let n = self.names.len();
         let zero = vec![0.0; n];
@@ -699,8 +700,11 @@ impl Linearizer {
         let mut c = DMatrix::<f64>::zeros(n, n);
         let mut v = vec![0.0; n];
         for b in 0..n {
-            // 1 mm/s at the coordinate's lever: small against any separation speed.
-            let dv = 1e-3 / self.scale[b];
+            // 1 um/s at the coordinate's lever. The rate-linear laws make any step exact while
+            // the contact force stays positive, but 1 mm/s times a damper of 1e7 N s/m is 10 kN,
+            // more than a lightly loaded contact carries: the force was clipped at zero and C
+            // came out asymmetric and indefinite (damping ratio -0.45 seen).
+            let dv = 1e-6 / self.scale[b];
             v[b] = dv;
             let q1 = self.dynamic_force(eq, &zero, &v)?;
             v[b] = 0.0;
