@@ -363,3 +363,25 @@ def test_plot_geometry_draws_discs_and_numbered_pins(paper_disc):
     fig2, ax2 = new_figure()
     assert plot_geometry(paper_disc, disc="rear", ax=ax2, number_pins=False) is fig2
     assert sum(isinstance(p, Polygon) for p in ax2.patches) == 1 and not ax2.texts
+
+
+def test_the_interference_remedy_works_for_the_pair() -> None:
+    # The suggested tooth count cleared only the named gear's tip: (5, 5) at 20 deg suggested
+    # 11 sun teeth, and (11, 5) then interfered the other way (an outside fuzz run). Now each
+    # suggested count makes a valid pair, with the other gear as it is.
+    import re
+
+    for deg in (10, 20, 25):
+        for z1 in range(5, 40, 3):
+            for z2 in range(5, 60, 4):
+                try:
+                    rvdyn.InvoluteStage(z1, z2, 1, 3e-3, math.radians(deg), 0.03)
+                except rvdyn.GeometryError as err:
+                    m = re.search(r"at least (\d+) (sun|planet) teeth", str(err))
+                    if "interference" not in str(err) or m is None:
+                        continue
+                    z = int(m.group(1))
+                    zs, zp = (z, z2) if m.group(2) == "sun" else (z1, z)
+                    rvdyn.InvoluteStage(zs, zp, 1, 3e-3, math.radians(deg), 0.03)
+    with pytest.raises(rvdyn.GeometryError, match="use more teeth or a larger pressure angle"):
+        rvdyn.InvoluteStage(5, 5, 1, 3e-3, math.radians(20), 0.03)

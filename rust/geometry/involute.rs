@@ -172,30 +172,43 @@ impl InvoluteStage {
         } else {
             ("planet", self.z_planet, self.z_sun)
         };
-        // The fewest teeth of the smaller gear that clear the other's tip at this angle.
-        let fits = |z: u32| {
-            let other = Self {
-                z_sun: z,
-                z_planet: z_other,
+        // The pair clears both tips: the fewest teeth of the interfering gear that do (with
+        // the other as it is), else of the other gear (a small one cannot be cleared).
+        let clear = |z_sun: u32, z_planet: u32| {
+            let s = Self {
+                z_sun,
+                z_planet,
                 ..*self
             };
-            let (_, a) = other.path_parts();
-            a <= other.sun_pitch_radius() * sin_a
+            let (r, a) = s.path_parts();
+            r <= s.planet_pitch_radius() * sin_a && a <= s.sun_pitch_radius() * sin_a
         };
-        let needed = (z_small..=MAX_TEETH).find(|&z| fits(z));
-        Err(RvdynError::Geometry(format!(
-            "involute interference: the tip of the {}-tooth {} reaches below the base circle \
-             of the {}-tooth {small} (pressure angle {:.1} deg), where a standard gear has no \
-             involute (it is undercut); rvdyn models unshifted full involutes only: use {} or \
-             a larger pressure angle",
-            z_other,
-            if small == "sun" { "planet" } else { "sun" },
-            z_small,
-            self.pressure_angle.to_degrees(),
-            match needed {
-                Some(z) => format!("at least {z} {small} teeth"),
-                None => format!("more {small} teeth"),
+        let other = if small == "sun" { "planet" } else { "sun" };
+        let pair = |z_named: u32, named_is_sun: bool, z_fixed: u32| {
+            if named_is_sun {
+                clear(z_named, z_fixed)
+            } else {
+                clear(z_fixed, z_named)
             }
+        };
+        let remedy = if let Some(z) =
+            (z_small..=MAX_TEETH).find(|&z| pair(z, small == "sun", z_other))
+        {
+            format!("at least {z} {small} teeth")
+        } else if let Some(z) = (z_other..=MAX_TEETH).find(|&z| pair(z, other == "sun", z_small)) {
+            format!(
+                "at least {z} {other} teeth (no number of {small} teeth clears a {z_other}-tooth \
+                 {other})"
+            )
+        } else {
+            "more teeth".to_string()
+        };
+        Err(RvdynError::Geometry(format!(
+            "involute interference: the tip of the {z_other}-tooth {other} reaches below the base \
+             circle of the {z_small}-tooth {small} (pressure angle {:.1} deg), where a standard \
+             gear has no involute (it is undercut); rvdyn models unshifted full involutes only: \
+             use {remedy} or a larger pressure angle",
+            self.pressure_angle.to_degrees(),
         )))
     }
 
