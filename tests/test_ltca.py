@@ -170,7 +170,7 @@ def test_analyze_command_writes_figures_loads_and_summary(tmp_path: Path) -> Non
     assert not any(k.startswith("te_peak_to_peak") and k != "te_peak_to_peak_arcsec" for k in summary)
     assert set(summary["te_peak_to_peak_arcsec"]) == {"forward", "reverse", "unloaded_forward",
                                                       "unloaded_reverse"}
-    assert "use points >= 84" in r.stderr
+    assert "use --angles >= 84" in r.stderr
     # The forward TE's largest harmonics, each with its order, label and uncertainty (None where
     # the grid gives no estimate; JSON has no NaN).
     h = summary["te_harmonics_forward"]
@@ -235,3 +235,15 @@ def test_te_harmonics_of_a_known_curve_are_exact() -> None:
         te.harmonics("forward", 0)
     with pytest.raises(rvdyn.ParameterError, match="was not computed"):
         dataclasses.replace(te, unloaded_forward=np.zeros(0)).harmonics("unloaded_forward")
+
+
+def test_light_load_and_torque_limits() -> None:
+    # A light load above the torque was accepted and then advised to be raised further; a zero
+    # --torque failed only in the loop, after the LTCA and the TE.
+    from rvdyn.analysis import transmission_error
+
+    with pytest.raises(rvdyn.ParameterError, match="light must be a load between 0 and the torque"):
+        transmission_error(rvdyn.Scene.paper("rated"), None, 6, light=1e9)
+    r = subprocess.run([sys.executable, "-m", "rvdyn", "analyze", "--torque", "0"], capture_output=True,
+                       text=True, timeout=300)
+    assert r.returncode == 1 and "--torque must be a finite, non-zero" in r.stderr

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -59,6 +60,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.angles is not None and args.angles < 2:
         raise ParameterError(f"--angles must be at least 2 crank angles per mesh period, got {args.angles}")
+    if args.torque is not None and not (math.isfinite(args.torque) and args.torque != 0.0):
+        raise ParameterError(f"--torque must be a finite, non-zero output torque [N m], got {args.torque}")
     if args.loop_points < 8:
         raise ParameterError(f"--loop-points must be at least 8, got {args.loop_points}")
     if args.torque is None and scene["load.kind"] != "constant":

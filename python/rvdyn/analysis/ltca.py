@@ -534,6 +534,9 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
     # The light load: 1e-6 of the torque, but not below 1e-3 N m (the torque-twist loop's zero
     # points), where a floating body settles reliably above the forces' round-off.
     lt = max(1e-6 * t, min(1e-3, 0.01 * t)) if light is None else abs(_float("light", light, "N m"))
+    if not 0.0 < lt < t:
+        raise ParameterError(f"light must be a load between 0 and the torque {t:.6g} N m (the unloaded TE's "
+                             f"light load; default 1e-6 of the torque, at least 1e-3 N m), got {lt:.6g} N m")
     periods = _window_periods(float(solver.te_window), period) if window else 1
     try:
         d = solver.transmission_error(t, lt, int(points), _float("start", start, "rad"), False, periods)
