@@ -56,7 +56,8 @@ class Modes:
     """Modes about one equilibrium, lowest first (n coordinates = n modes).
 
     frequency [Hz]: undamped natural frequencies; damping_ratio: of the matched damped
-    eigenvalue (``matched``; otherwise the modal estimate ``phi^T C phi / 2 w``);
+    eigenvalue (``matched``; NaN otherwise, and ``modal_damping_ratio`` holds the modal
+    estimate ``phi^T C phi / 2 w``, which :func:`rvdyn.campbell` uses for unmatched modes);
     damped_natural_frequency [Hz] (``|lambda| / 2 pi``), damped_frequency [Hz]
     (``Im lambda / 2 pi``, 0 when overdamped); shape (modes, coordinates): scaled so that the
     largest displacement at the coordinate's lever is +1; energy_share (modes, parts): share

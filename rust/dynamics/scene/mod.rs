@@ -632,7 +632,8 @@ impl Friction {
             if b.viscosity > MAX_OIL_VISCOSITY {
                 return bad(format!(
                     "friction.bearing.viscosity is a kinematic viscosity in m^2/s, got {} m^2/s \
-                     ({:.0} cSt, more than any bearing oil); 68 cSt is 68e-6 m^2/s",
+                     ({:.6} cSt, above the limit of {MAX_OIL_VISCOSITY} m^2/s = 10 000 cSt, more than \
+                     any bearing oil); 68 cSt is 68e-6 m^2/s",
                     b.viscosity,
                     b.viscosity * 1e6
                 ));
