@@ -141,26 +141,19 @@ pub fn campbell(
                 m
             }
         };
-        frequencies.push(
-            keep.iter()
-                .map(|&i| {
-                    let m = &a.modes[i];
-                    m.damped
-                        .as_ref()
-                        .map_or(m.frequency, |d| d.natural_frequency)
-                })
-                .collect(),
-        );
-        damping_ratios.push(
-            keep.iter()
-                .map(|&i| {
-                    let m = &a.modes[i];
-                    m.damped
-                        .as_ref()
-                        .map_or(m.modal_damping_ratio, |d| d.damping_ratio)
-                })
-                .collect(),
-        );
+        // The matched damped eigenvalue's, else the undamped frequency and modal estimate.
+        let (f, z): (Vec<f64>, Vec<f64>) = keep
+            .iter()
+            .map(|&i| {
+                let m = &a.modes[i];
+                match &m.damped {
+                    Some(d) => (d.natural_frequency, d.damping_ratio),
+                    None => (m.frequency, m.modal_damping_ratio),
+                }
+            })
+            .unzip();
+        frequencies.push(f);
+        damping_ratios.push(z);
     }
     let crossings = campbell_crossings(speeds, &frequencies, &orders)?;
     Ok(Campbell {

@@ -184,7 +184,9 @@ impl SimOptions {
         if let Some(r) = self.record_interval
             && !(r.is_finite() && r > 0.0)
         {
-            return bad(format!("record_interval must be a finite time > 0 s, got {r}"));
+            return bad(format!(
+                "record_interval must be a finite time > 0 s, got {r}"
+            ));
         }
         if !(2..=MAX_SAMPLES).contains(&self.max_samples) {
             return bad(format!(
