@@ -63,33 +63,32 @@ fn pair_from_invariants([s, d]: [Complex<f64>; 2]) -> [Complex<f64>; 2] {
     [(s + r) * 0.5, (s - r) * 0.5]
 }
 
-/// Follow the damped eigenvalues of modes `modes` (two points each in `start`, consecutive)
-/// along the straight path from the system `(kt0, ct0)` to `(kt1, ct1)`, `beta` from 0 to 1
-/// with a first step `h0`: at each step the 2n eigenvalues are assigned one to one, nearest
-/// first, to the points predicted from each pair's sum and squared difference extrapolated in
-/// `beta` (smooth where the pair meets on the real axis), and the step is halved until every
-/// point's eigenvalue is nearer than a third of the distance to any eigenvalue another mode
-/// holds (a pair that meets on the real axis and splits into two real roots stays with its
-/// mode). Used from zero damping (`ct0 = 0`, `start = +-i w_j`): the continuation in the
-/// damping, which defines which damped solution belongs to which undamped mode (a path in
-/// another parameter can end on a different assignment: eigenvalues of a non-symmetric
-/// problem can swap around an exceptional point). Returns each mode's two eigenvalues at
-/// `beta = 1`, or `None` when the step falls below 1e-7 (modes that stay together, such as
-/// equal frequencies) or after 5000 steps.
-fn track(
-    (kt0, ct0): (&DMatrix<f64>, &DMatrix<f64>),
-    (kt1, ct1): (&DMatrix<f64>, &DMatrix<f64>),
+/// Follow the damped eigenvalues of the flexible modes `omegas` (`(j, w_j)`) from `+-i w_j`
+/// as the damping `alpha ct` grows from 0 to `ct`: at each step the 2n eigenvalues are
+/// assigned one to one, nearest first, to the points predicted from each pair's sum and squared
+/// difference extrapolated in `alpha` (smooth where the pair meets on the real axis), and the
+/// step (0.02 at first) is halved until every point's eigenvalue is nearer than a third of the
+/// distance to any eigenvalue another mode holds (a pair that meets on the real axis and
+/// splits into two real roots stays with its mode). This continuation defines which damped
+/// solution belongs to which undamped mode (a path in another parameter can end on a different
+/// assignment: eigenvalues of a non-symmetric problem can swap around an exceptional point).
+/// Returns each mode's two eigenvalues at `alpha = 1`, or `None` when the step falls below
+/// 1e-7 (modes that stay together, such as equal frequencies) or after 5000 steps.
+fn continuation(
+    kt: &DMatrix<f64>,
+    ct: &DMatrix<f64>,
     s: f64,
-    modes: &[usize],
-    start: Vec<Complex<f64>>,
-    h0: f64,
+    omegas: &[(usize, f64)],
     tol_im: f64,
 ) -> Option<Vec<(usize, [Complex<f64>; 2])>> {
-    let (dk, dc) = (kt1 - kt0, ct1 - ct0);
-    let mut pts = start;
+    let modes: Vec<usize> = omegas.iter().map(|&(j, _)| j).collect();
+    let mut pts: Vec<Complex<f64>> = omegas
+        .iter()
+        .flat_map(|&(_, w)| [Complex::new(0.0, w), Complex::new(0.0, -w)])
+        .collect();
     let mut prev: Option<(Vec<Complex<f64>>, f64)> = None;
     let mut prev2: Option<(Vec<Complex<f64>>, f64)> = None;
-    let (mut alpha, mut h) = (0.0f64, h0);
+    let (mut alpha, mut h) = (0.0f64, 0.02f64);
     let mut steps = 0;
     while alpha < 1.0 {
         steps += 1;
@@ -97,12 +96,7 @@ fn track(
             return None;
         }
         let h_try = h.min(1.0 - alpha);
-        let b = alpha + h_try;
-        let e = if b == 1.0 {
-            state_eigenvalues(kt1, ct1, s).ok()?
-        } else {
-            state_eigenvalues(&(kt0 + &dk * b), &(ct0 + &dc * b), s).ok()?
-        };
+        let e = state_eigenvalues(kt, &(ct * (alpha + h_try)), s).ok()?;
         // Each mode's pair through its sum and squared difference, which stay smooth where
         // the pair meets on the real axis and splits (the roots themselves move there like a
         // square root): extrapolated quadratically through the last three steps (linearly
@@ -143,7 +137,7 @@ fn track(
         alpha += h_try;
         h = (1.5 * h_try).min(0.1);
     }
-    Some(pair_up(modes, &pts, tol_im))
+    Some(pair_up(&modes, &pts, tol_im))
 }
 
 /// The tracked points `pts` (two per mode, in the order of `modes`) as each mode's pair, with
@@ -351,14 +345,7 @@ pub(super) fn damped_modes(
             };
             assign(&pts, &raw).map(|next| pair_up(&modes, &next, tol_im))
         });
-        let ends = from_hint.or_else(|| {
-            let start = omegas
-                .iter()
-                .flat_map(|&(_, w)| [Complex::new(0.0, w), Complex::new(0.0, -w)])
-                .collect();
-            let zero = DMatrix::<f64>::zeros(n, n);
-            track((kt, &zero), (kt, ct), s, &flexible, start, 0.02, tol_im)
-        });
+        let ends = from_hint.or_else(|| continuation(kt, ct, s, &omegas, tol_im));
         if let Some(o) = ends.and_then(|e| owners_from_ends(&cands, &e, shapes, &mac)) {
             owner = o;
         }
