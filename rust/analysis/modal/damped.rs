@@ -66,10 +66,11 @@ fn pair_from_invariants([s, d]: [Complex<f64>; 2]) -> [Complex<f64>; 2] {
 /// Follow the damped eigenvalues of the flexible modes `omegas` (`(j, w_j)`) from `+-i w_j`
 /// as the damping `alpha ct` grows from 0 to `ct`: at each step the 2n eigenvalues are
 /// assigned one to one, nearest first, to the points predicted from each pair's sum and squared
-/// difference extrapolated in `alpha` (smooth where the pair meets on the real axis), and the
-/// step (0.02 at first) is halved until every point's eigenvalue is nearer than a third of the
-/// distance to any eigenvalue another mode holds (a pair that meets on the real axis and
-/// splits into two real roots stays with its mode). This continuation defines which damped
+/// difference extrapolated in `alpha` (smooth where the pair meets on the real axis; the first
+/// step from first-order perturbation, `slopes[j] = y_j^T ct y_j`), and a step is halved until
+/// every point's eigenvalue is nearer than a third of the distance to any eigenvalue another
+/// mode holds (a pair that meets on the real axis and splits into two real roots stays with
+/// its mode); the next step is sized from the accepted one's margin. This continuation defines which damped
 /// solution belongs to which undamped mode (a path in another parameter can end on a different
 /// assignment: eigenvalues of a non-symmetric problem can swap around an exceptional point).
 /// Returns each mode's two eigenvalues at `alpha = 1`, or `None` when the step falls below
@@ -79,6 +80,7 @@ fn continuation(
     ct: &DMatrix<f64>,
     s: f64,
     omegas: &[(usize, f64)],
+    slopes: &[f64],
     tol_im: f64,
 ) -> Option<Vec<(usize, [Complex<f64>; 2])>> {
     let modes: Vec<usize> = omegas.iter().map(|&(j, _)| j).collect();
@@ -125,17 +127,30 @@ fn continuation(
                 .zip(invariants(p1))
                 .map(|(c, b)| [0, 1].map(|i| c[i] + (c[i] - b[i]) * (h_try / h1)))
                 .collect(),
-            _ => now,
+            // From zero damping: first-order perturbation of each undamped pair, whose sum
+            // moves by `-alpha y^T ct y` and whose squared difference does not move.
+            _ => now
+                .iter()
+                .zip(slopes)
+                .map(|(c, sl)| [c[0] - h_try * sl, c[1]])
+                .collect(),
         };
         let pred: Vec<Complex<f64>> = guess.into_iter().flat_map(pair_from_invariants).collect();
-        let Some(next) = assign(&pred, &e) else {
+        let Some((next, worst)) = assign_with_margin(&pred, &e) else {
             h = 0.5 * h_try;
             continue;
         };
         prev2 = prev.take();
         prev = Some((std::mem::replace(&mut pts, next), h_try));
         alpha += h_try;
-        h = (1.5 * h_try).min(0.1);
+        // The prediction error grows like h^3 (quadratic extrapolation): aim at a margin of
+        // 1/6, half the acceptance limit.
+        let grow = if worst > 0.0 {
+            0.9 * (1.0 / (6.0 * worst)).cbrt()
+        } else {
+            2.0
+        };
+        h = (h_try * grow.clamp(0.5, 2.0)).min(0.25);
     }
     Some(pair_up(&modes, &pts, tol_im))
 }
@@ -162,6 +177,15 @@ fn pair_up(modes: &[usize], pts: &[Complex<f64>], tol_im: f64) -> Vec<(usize, [C
 /// nearer than a third of the distance to any eigenvalue another mode holds or none does
 /// (rigid-body roots).
 fn assign(pred: &[Complex<f64>], e: &[Complex<f64>]) -> Option<Vec<Complex<f64>>> {
+    assign_with_margin(pred, e).map(|(v, _)| v)
+}
+
+/// As `assign`, also returning the largest ratio of a point's distance to its eigenvalue over
+/// the distance to the nearest eigenvalue another mode holds (`assign` accepts up to 1/3).
+fn assign_with_margin(
+    pred: &[Complex<f64>],
+    e: &[Complex<f64>],
+) -> Option<(Vec<Complex<f64>>, f64)> {
     let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(pred.len() * e.len());
     for (i, p) in pred.iter().enumerate() {
         for (k, v) in e.iter().enumerate() {
@@ -180,7 +204,8 @@ fn assign(pred: &[Complex<f64>], e: &[Complex<f64>]) -> Option<Vec<Complex<f64>>
     if of_point.contains(&usize::MAX) {
         return None;
     }
-    let clear = pred.iter().enumerate().all(|(i, p)| {
+    let mut worst = 0.0f64;
+    for (i, p) in pred.iter().enumerate() {
         let d1 = (p - e[of_point[i]]).norm();
         let d2 = e
             .iter()
@@ -188,9 +213,9 @@ fn assign(pred: &[Complex<f64>], e: &[Complex<f64>]) -> Option<Vec<Complex<f64>>
             .filter(|&(k, _)| taken[k] == usize::MAX || taken[k] / 2 != i / 2)
             .map(|(_, v)| (p - v).norm())
             .fold(f64::INFINITY, f64::min);
-        d1 <= d2 / 3.0
-    });
-    clear.then(|| of_point.iter().map(|&k| e[k]).collect())
+        worst = worst.max(if d1 == 0.0 { 0.0 } else { d1 / d2 });
+    }
+    (worst <= 1.0 / 3.0).then(|| (of_point.iter().map(|&k| e[k]).collect(), worst))
 }
 
 /// The candidates' owners from the continuation's end points: a conjugate pair gives its
@@ -345,7 +370,11 @@ pub(super) fn damped_modes(
             };
             assign(&pts, &raw).map(|next| pair_up(&modes, &next, tol_im))
         });
-        let ends = from_hint.or_else(|| continuation(kt, ct, s, &omegas, tol_im));
+        let slopes: Vec<f64> = omegas
+            .iter()
+            .map(|&(j, _)| shapes[j].dot(&(ct * &shapes[j])))
+            .collect();
+        let ends = from_hint.or_else(|| continuation(kt, ct, s, &omegas, &slopes, tol_im));
         if let Some(o) = ends.and_then(|e| owners_from_ends(&cands, &e, shapes, &mac)) {
             owner = o;
         }
