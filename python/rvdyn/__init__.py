@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 
-from . import _core
+from . import _args, _core
 from ._core import (
     PAPER_IMPACT_DEPTH,
     PAPER_IMPACT_EXPONENT,
@@ -119,10 +119,12 @@ __all__ = [
 
 
 def deg_s(rad_per_s: float) -> float:
-    """Convert an angular speed from rad/s to deg/s (e.g. for comparing with the paper)."""
-    return float(rad_per_s) * 180.0 / math.pi
+    """Convert an angular speed from rad/s to deg/s (e.g. for comparing with the paper). A
+    value that is not a finite number is a :class:`ParameterError`."""
+    return _args.real("rad_per_s", rad_per_s, "rad/s") * 180.0 / math.pi
 
 
 def rad_s(deg_per_s: float) -> float:
-    """Convert an angular speed from deg/s to rad/s (the paper's 8328 deg/s -> 145.35 rad/s)."""
-    return float(deg_per_s) * math.pi / 180.0
+    """Convert an angular speed from deg/s to rad/s (the paper's 8328 deg/s -> 145.35 rad/s). A
+    value that is not a finite number is a :class:`ParameterError`."""
+    return _args.real("deg_per_s", deg_per_s, "deg/s") * math.pi / 180.0

@@ -10,12 +10,14 @@ All inputs are SI (m, rad); axes show millimetres where that reads better, label
 from __future__ import annotations
 
 import math
-import operator
 from typing import TYPE_CHECKING, Any, Iterable, Sequence
 
 import numpy as np
 
 from . import _core
+from ._args import real as _real
+from ._args import short as _short
+from ._args import whole as _whole
 from .errors import ParameterError
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -33,43 +35,6 @@ _PER_MM15 = 1000.0**1.5
 
 #: Most profile points per lobe a geometry plot draws (a finer outline is invisible).
 MAX_SAMPLES_PER_LOBE = 10_000
-
-
-def _real(name: str, value: Any) -> float:
-    """``value`` as a finite float; a value Python cannot convert (a string, an int beyond the
-    float range) or a non-finite one is a ParameterError (the conversion error chained); a
-    wrong type stays a TypeError."""
-    try:
-        x = float(value)
-    except (OverflowError, ValueError) as e:
-        raise ParameterError(f"{name} must be a finite real number, got {_short(value)}") from e
-    if not math.isfinite(x):
-        raise ParameterError(f"{name} must be a finite real number, got {x!r}")
-    return x
-
-
-def _whole(name: str, value: Any, lo: int, hi: int) -> int:
-    """``value`` as an int in ``[lo, hi]`` (Python or numpy integers; not bool or float)."""
-    if isinstance(value, (bool, np.bool_)):
-        raise ParameterError(f"{name} must be a whole number from {lo} to {hi}, got {value!r}")
-    try:
-        n = operator.index(value)
-    except TypeError as e:
-        raise ParameterError(
-            f"{name} must be a whole number from {lo} to {hi}, got {_short(value)}"
-        ) from e
-    if not lo <= n <= hi:
-        raise ParameterError(f"{name} must be a whole number from {lo} to {hi}, got {_short(n)}")
-    return n
-
-
-def _short(value: Any, limit: int = 40) -> str:
-    """``repr(value)`` cut to ``limit`` characters (a 400-digit int prints as 40)."""
-    try:
-        text = repr(value)
-    except Exception:  # pragma: no cover - a repr that raises
-        text = f"<{type(value).__name__}>"
-    return text if len(text) <= limit else text[:limit] + "..."
 
 
 def pin_indices(pins: Iterable[Any], zp: int) -> list[int]:

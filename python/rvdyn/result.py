@@ -19,7 +19,10 @@ from numpy.typing import NDArray
 
 from . import _core
 from .errors import ParameterError, RvdynError
-from .plotting import _real, _whole, pin_indices
+from ._args import read_only
+from ._args import real as _real
+from ._args import whole as _whole
+from .plotting import pin_indices
 
 __all__ = ["Result", "CHANNELS", "CHANNEL_SPECS"]
 
@@ -118,7 +121,7 @@ class Result:
         unknown = set(arrays) - set(CHANNEL_SPECS)
         if unknown:
             raise ParameterError(f"unknown channels {sorted(unknown)}: the channels are {sorted(CHANNEL_SPECS)}")
-        self._arrays: dict[str, NDArray[Any]] = dict(arrays)
+        self._arrays: dict[str, NDArray[Any]] = {k: read_only(np.asarray(v)) for k, v in arrays.items()}
         self.stats: dict[str, Any] = dict(stats)
         self.scene: dict[str, Any] = scene or {}
         self.options: dict[str, Any] = options or {}

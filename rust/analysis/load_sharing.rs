@@ -61,9 +61,12 @@ pub fn classical_pin_forces(
 pub fn classical_levers(geometry: &CycloidGeometry, crank_angle: f64) -> Vec<f64> {
     let k1 = geometry.k1();
     let rc = geometry.pitch_radius();
+    // Reduced first (exactly): at |angle| ~ 1e16 rad the pins' offsets 2 pi j / zp would fall
+    // below the angle's last bit and every pin would get the same lever.
+    let psi = crank_angle.rem_euclid(std::f64::consts::TAU);
     (0..geometry.pins() as usize)
         .map(|j| {
-            let phi = geometry.pin_angle(j) - crank_angle;
+            let phi = geometry.pin_angle(j) - psi;
             let s = (1.0 + k1 * k1 - 2.0 * k1 * phi.cos()).sqrt();
             rc * phi.sin() / s
         })
@@ -74,6 +77,18 @@ pub fn classical_levers(geometry: &CycloidGeometry, crank_angle: f64) -> Vec<f64
 mod tests {
     use super::*;
     use crate::geometry::cycloid::CycloidParams;
+
+    #[test]
+    fn huge_crank_angles_keep_the_load_pattern() {
+        let g = CycloidGeometry::new(CycloidParams::paper()).unwrap();
+        for psi in [1e17, -1e17, 1e300] {
+            let f = classical_pin_forces(&g, 1e3, psi).unwrap();
+            assert_eq!(f.iter().filter(|x| **x > 0.0).count(), 12, "{psi}: {f:?}");
+            let l = classical_levers(&g, psi);
+            let moment: f64 = f.iter().zip(&l).map(|(a, b)| a * b).sum();
+            assert!((moment - 1e3).abs() < 1e-9 * 1e3);
+        }
+    }
 
     #[test]
     fn forces_balance_the_torque_and_match_the_closed_form_maximum() {

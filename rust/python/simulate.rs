@@ -18,7 +18,17 @@ use std::time::{Duration, Instant};
 /// Most worker threads a sweep may ask for.
 const MAX_THREADS: usize = 1024;
 
-/// Options of a run (all but the end time), validated when built. `rvdyn.Options`.
+/// Options of a dynamic run (all but the end time), validated when built; None = default.
+///
+/// integrator: "generalized-alpha" (default), "generalized-alpha-adaptive", "dopri5" or "rk4";
+/// dt [s] (None = the integrator's default: 1e-4, 1e-5 (initial), 1e-6 (initial), 1e-5 s);
+/// rtol (adaptive, velocities, default 1e-6, at most 1e-2); atol [m] (displacement tolerance
+/// of the error control and of Newton, default 1e-9 m, at most 1e-6 m); rho_inf in [0, 1]
+/// (default 0.8); record_interval [s], <= t_end (None = 1e-4 s or t_end if shorter);
+/// max_samples (default 50 000); channels (groups: "motion", "pins", "contact_points", "mesh",
+/// "energy", "bearings"; None = all but contact points); skip_separated (default True);
+/// step_check ("warn", "raise" or "off": a fixed step that cannot be accurate, default "warn");
+/// h_min [s] and max_steps (bounds of an adaptive method, default 1e-13 s and 1e8).
 #[pyclass(name = "Options", module = "rvdyn", frozen, eq)]
 #[derive(Clone, PartialEq)]
 pub(crate) struct Options {

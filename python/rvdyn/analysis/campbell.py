@@ -16,7 +16,8 @@ import numpy as np
 from .. import _core
 from ..errors import ParameterError
 from .modes import _finite, _loaded_torque, _scene
-from ..plotting import _whole
+from .._args import pair as _pair
+from .._args import whole as _whole
 from .spectrum import MAX_HARMONICS, ExcitationOrder
 
 __all__ = ["CampbellDiagram", "Crossing", "campbell", "travel_to_input_speed", "PAPER_TRAVEL_RANGE_KMH"]
@@ -127,13 +128,18 @@ def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, 
     torque or power is a ``ParameterError``: unloaded contacts have no stiffness."""
     scene = _scene(scene)
     n_harmonics = _whole("harmonics", harmonics, 1, MAX_HARMONICS)
+    n = _whole("points", points, 2, 1_000_000)
     if speeds is None:
-        n = _whole("points", points, 2, 1_000_000)
         # The paper's travel range at this reducer's ratio (the same wheel speeds).
         scale = abs(float(scene.ratio)) / PAPER_RATIO
         lo, hi = (scale * float(v) for v in travel_to_input_speed(np.array(PAPER_TRAVEL_RANGE_KMH)))
         speeds = np.linspace(lo, hi, n)
-    w = np.asarray(speeds, dtype=float).ravel()
+    try:
+        w = np.asarray(speeds, dtype=float).ravel()
+    except (OverflowError, TypeError, ValueError) as e:
+        raise ParameterError(f"speeds must be input speeds [rad/s], a 1-D list of numbers: {e}") from e
+    if w.size == 0:
+        raise ParameterError("speeds is empty: give at least one input speed [rad/s]")
     if power is not None and torque is not None:
         raise ParameterError("give power or torque, not both")
     if power is not None:
@@ -148,8 +154,7 @@ def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, 
         raise ParameterError("campbell about equilibria needs a load: power 0 W leaves the contacts without "
                              "load and every frequency would be round-off; give a power or torque")
     if frequency_range is not None:
-        frequency_range = (_finite("frequency_range[0]", frequency_range[0], "Hz"),
-                           _finite("frequency_range[1]", frequency_range[1], "Hz"))
+        frequency_range = _pair("frequency_range", frequency_range, "Hz")
     d = _core.campbell_diagram(scene.to_json(), [float(x) for x in w], [float(x) for x in t],
                                _finite("crank_angle", crank_angle, "rad"), n_harmonics, frequency_range)
     orders = [ExcitationOrder(n, int(h), float(o), lab) for n, h, o, lab in d["orders"]]

@@ -12,7 +12,8 @@ import numpy as np
 
 from .. import _core
 from ..errors import ConvergenceError, ParameterError
-from ..plotting import _whole
+from .._args import read_only, short
+from .._args import whole as _whole
 from ..scene import Scene
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -42,8 +43,8 @@ def _scene(scene: object) -> Scene:
 def _float(name: str, value: object, unit: str) -> float:
     try:
         x = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a number [{unit}], got {value!r}") from None
+    except (OverflowError, TypeError, ValueError):
+        raise ParameterError(f"{name} must be a number [{unit}], got {short(value)}") from None
     if not math.isfinite(x):
         raise ParameterError(f"{name} must be a finite number [{unit}], got {x}")
     return x
@@ -83,6 +84,9 @@ class LtcaResult:
     arrays: dict[str, np.ndarray] = field(repr=False)
     fea_csv: str = field(repr=False)
     fea_json: str = field(repr=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "arrays", {k: read_only(np.asarray(v)) for k, v in self.arrays.items()})
 
     def __getattr__(self, name: str) -> np.ndarray:
         arrays = object.__getattribute__(self, "arrays")
@@ -227,6 +231,10 @@ class TransmissionError:
     #: The scene's excitation orders as (order, label), for the harmonics' labels.
     excitation: tuple[tuple[float, str], ...] = field(default=(), repr=False)
 
+    def __post_init__(self) -> None:
+        for name in ("crank_angle", "forward", "reverse", "unloaded_forward", "unloaded_reverse"):
+            object.__setattr__(self, name, read_only(np.asarray(getattr(self, name), dtype=float)))
+
     def harmonics(self, curve: str = "forward", count: int = 8) -> list[TeHarmonic]:
         """The ``count`` largest harmonics of ``curve`` (``"forward"``, ``"reverse"``,
         ``"unloaded_forward"``, ``"unloaded_reverse"``) over the ``periods`` covered, largest
@@ -355,6 +363,10 @@ class TwistLoop:
     backlash: float
     friction: bool = False
 
+    def __post_init__(self) -> None:
+        for name in ("torque", "twist", "tangent_stiffness"):
+            object.__setattr__(self, name, read_only(np.asarray(getattr(self, name), dtype=float)))
+
     def branches(self) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
         """The loop's upper (unloading, ``+rated -> -rated``) and lower (loading, ``-rated ->
         +rated``: the last quarter, then the first) branches as ``(torque, twist)`` pairs with
@@ -421,6 +433,9 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
 
     ``tolerance``: Newton's residual target, a fraction of the load scale (``|T| / rp``), in
     (0, 1e-6]; the balance of every body closes to 1e-9 at the default 1e-12.
+    ``chunk``: crank angles solved per call into the core (a whole number >= 1, default 360);
+    ``progress(done, total)`` is called after each chunk with the angles solved so far and
+    their total (e.g. for a progress bar); the results do not depend on ``chunk``.
 
     The equilibria are frictionless whatever the scene's ``friction``: friction enters
     :func:`torque_twist` (by default) and :func:`running_friction`.
@@ -436,7 +451,7 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
     else:
         try:
             angles = np.atleast_1d(np.asarray(crank_angles, dtype=float))
-        except (TypeError, ValueError) as e:
+        except (OverflowError, TypeError, ValueError) as e:
             raise ParameterError(f"crank_angles must be real numbers [rad]: {e}") from e
     if angles.ndim != 1 or angles.size == 0:
         raise ParameterError(f"crank_angles must be a non-empty 1-D array [rad], got shape {angles.shape}")
@@ -445,7 +460,7 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
     tol = _float("tolerance", tolerance, "-")
     solver = _core.LtcaSolver(sc._compiled, tol)
     parts: list[dict[str, np.ndarray]] = []
-    step = max(int(chunk), 1)
+    step = _whole("chunk", chunk, 1, MAX_POINTS)
     for start in range(0, angles.size, step):
         # The solver keeps its warm start and its points across chunks.
         parts.append(solver.sweep(t, angles[start:start + step].tolist()))

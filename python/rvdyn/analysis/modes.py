@@ -17,7 +17,11 @@ from typing import Any, Sequence
 import numpy as np
 
 from .. import _core
+from .._args import short, whole
 from ..errors import ParameterError
+
+#: Most crank angles ``modes_over_mesh`` takes (one modal analysis each).
+MAX_MESH_POINTS: int = 1_000_000
 
 __all__ = ["Modes", "MeshSweep", "modes", "modes_at", "modes_over_mesh", "scene_torque"]
 
@@ -44,8 +48,8 @@ def scene_torque(scene: Any) -> float:
 def _finite(name: str, value: Any, unit: str) -> float:
     try:
         v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a number [{unit}], got {value!r}") from None
+    except (OverflowError, TypeError, ValueError):
+        raise ParameterError(f"{name} must be a number [{unit}], got {short(value)}") from None
     if not math.isfinite(v):
         raise ParameterError(f"{name} must be finite [{unit}], got {v}")
     return v
@@ -324,8 +328,7 @@ def modes_over_mesh(scene: Any, torque: float | None = None, points: int = 25,
     sweep either. Torque [N m] as in :func:`modes` (not zero: ``ParameterError``)."""
     scene = _scene(scene)
     t = _loaded_torque(scene, torque, "modes_over_mesh")
-    if not isinstance(points, (int, np.integer)) or points < 2:
-        raise ParameterError(f"points must be a whole number >= 2, got {points!r}")
+    points = whole("points", points, 2, MAX_MESH_POINTS)
     per = 2 * math.pi / int(scene["cycloid.pins"]) if period is None else _finite("period", period, "rad")
     if per <= 0:
         raise ParameterError(f"period must be > 0 rad, got {per}")

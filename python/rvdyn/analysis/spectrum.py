@@ -27,7 +27,9 @@ import numpy as np
 
 from .. import _core
 from ..errors import ParameterError
-from ..plotting import _whole
+from .._args import pair as _pair
+from .._args import real as _real
+from .._args import whole as _whole
 
 __all__ = ["ExcitationOrder", "SpectrumPeak", "OrderSpectrum", "excitation_orders", "order_spectrum",
            "plot_order_spectrum"]
@@ -178,10 +180,19 @@ def order_spectrum(result: Any, channel: str, window: tuple[float, float] | None
         raise ParameterError(f"detrend must be 'mean' or 'linear', got {detrend!r}")
     if not (isinstance(peaks, (int, np.integer)) and peaks >= 1):
         raise ParameterError(f"peaks must be a whole number >= 1, got {peaks!r}")
-    if not (math.isfinite(tolerance) and tolerance >= 0):
+    tolerance = _real("tolerance", tolerance)
+    if not tolerance >= 0:
         raise ParameterError(f"tolerance must be finite and >= 0, got {tolerance}")
-    if not (math.isfinite(threshold) and 0 <= threshold < 1):
+    threshold = _real("threshold", threshold)
+    if not 0 <= threshold < 1:
         raise ParameterError(f"threshold must be in [0, 1), got {threshold}")
+    if orders is not None:
+        if isinstance(orders, (str, bytes)) or not isinstance(orders, Sequence):
+            raise ParameterError(f"orders must be a list of rvdyn.ExcitationOrder, got {type(orders).__name__}")
+        wrong = [o for o in orders if not isinstance(o, ExcitationOrder)]
+        if wrong:
+            raise ParameterError(
+                f"orders must be rvdyn.ExcitationOrder values (e.g. from excitation_orders(scene)), got {wrong[0]!r}")
     try:
         data = np.asarray(getattr(result, channel), dtype=float)
     except AttributeError as e:
@@ -199,9 +210,11 @@ def order_spectrum(result: Any, channel: str, window: tuple[float, float] | None
             raise ParameterError(f"index {index!r} leaves shape {data.shape[1:]} per sample; give one index per axis")
         channel_name = f"{channel}[{', '.join(str(int(i)) for i in idx)}]"
     else:
+        if index is not None:
+            raise ParameterError(f"channel {channel!r} has one value per sample: leave index=None")
         channel_name = channel
     t = np.asarray(result.t, dtype=float)
-    t0, t1 = result.steady_window() if window is None else (float(window[0]), float(window[1]))
+    t0, t1 = result.steady_window() if window is None else _pair("window", window, "s")
     if not (math.isfinite(t0) and math.isfinite(t1) and t[0] <= t0 < t1 <= t[-1] + 1e-12):
         raise ParameterError(f"window ({t0}, {t1}) s must lie inside the run [{t[0]}, {t[-1]}] s with t0 < t1")
     sel = (t >= t0 - 1e-12) & (t <= t1 + 1e-12)
