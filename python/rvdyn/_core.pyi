@@ -157,7 +157,10 @@ class CycloidGeometry:
         """Pin centres (zp, 2) [m]; row j is at angle 2 pi j / zp, the paper's pin j + 1."""
     def classical_pin_forces(self, disc_torque: float, crank_angle: float) -> NDArray[np.float64]:
         """Classical quasi-static pin forces (zp,) [N] of the unmodified disc carrying
-        disc_torque [N m] about its centre at crank angle crank_angle [rad]."""
+        disc_torque [N m] about its centre at crank angle crank_angle [rad]: F_j = T l_j / sum l^2
+        on the pins whose lever l_j has the torque's sign. A positive output torque of the
+        reducer loads the pins with negative lever: compare ltca(scene, +T) with
+        classical_pin_forces(-T_c, psi)."""
     def classical_levers(self, crank_angle: float) -> NDArray[np.float64]:
         """Levers (zp,) [m] of the contact normals about the disc centre at crank angle [rad]."""
     def kinematic_pose(self, psi: float) -> tuple[NDArray[np.float64], float]:

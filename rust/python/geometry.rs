@@ -355,7 +355,9 @@ impl PyCycloidGeometry {
     /// Classical quasi-static pin forces [N], shape (zp,), of the unmodified disc carrying
     /// `disc_torque` [N m] about its centre with its centre at crank angle `crank_angle` [rad]
     /// (docs/model.md#lever-arms-and-the-classical-load-sharing: F_j = T l_j / sum l^2 on the
-    /// loaded half).
+    /// loaded half, the pins with lever of the torque's sign). A positive output torque of the
+    /// reducer loads the pins with negative lever: compare `ltca(scene, +T)` with
+    /// `classical_pin_forces(-T_c, psi)`.
     fn classical_pin_forces<'py>(
         &self,
         py: Python<'py>,

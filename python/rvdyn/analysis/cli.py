@@ -117,7 +117,8 @@ def run(args: argparse.Namespace) -> int:
         f"- loaded pins per disc: {summary['loaded_pins_min']}-{summary['loaded_pins_max']}; "
         f"peak pin force {res.peak_pin_force / 1e3:.2f} kN; peak Hertz pressure "
         f"{summary['peak_pressure_max_Pa'] / 1e6:.0f} MPa",
-        f"- TE peak-to-peak: forward {pp['forward'] / ARCSEC:.3f} arcsec, reverse "
+        f"- TE peak-to-peak (forward at +{abs(res.torque):.1f} N m, reverse at -{abs(res.torque):.1f} N m, "
+        f"whatever the sign of --torque): forward {pp['forward'] / ARCSEC:.3f} arcsec, reverse "
         f"{pp['reverse'] / ARCSEC:.3f} arcsec (unloaded {pp['unloaded_forward'] / ARCSEC:.3f} / "
         f"{pp['unloaded_reverse'] / ARCSEC:.3f} arcsec)" + (
             "" if te.periods == 1 else

@@ -304,8 +304,11 @@ class TransmissionError:
                 f"torque={self.torque:.6g} N m, peak_to_peak_arcsec={{{pp}}}, window={self.window:.6g} rad)")
 
     def lost_motion(self) -> np.ndarray:
-        """Difference of the reverse and forward TE at each crank angle [rad] (the lost motion
-        at this torque)."""
+        """Difference of the reverse and forward TE at each crank angle [rad]: the twist width
+        between the TE's two torques, ``+-torque`` (on the paper preset at rated load about 12.8
+        arcmin). This is not the catalogue lost motion, the width at +-3 % of the rated torque
+        (about 1.26 arcmin there): that is :attr:`TwistLoop.lost_motion` of
+        :func:`torque_twist`."""
         diff: np.ndarray = self.reverse - self.forward
         return diff
 

@@ -167,6 +167,22 @@ pub struct TeExtremes {
     pub unloaded_reverse: Option<CurveExtremes>,
 }
 
+impl TeExtremes {
+    /// The same extremes at crank angles `shift` \[rad\] later.
+    fn shift(&mut self, shift: f64) {
+        let curves = [Some(&mut self.forward), Some(&mut self.reverse)]
+            .into_iter()
+            .chain([
+                self.unloaded_forward.as_mut(),
+                self.unloaded_reverse.as_mut(),
+            ]);
+        for c in curves.flatten() {
+            c.max.crank_angle += shift;
+            c.min.crank_angle += shift;
+        }
+    }
+}
+
 impl CurveExtremes {
     /// The extremes of two stretches of one curve together.
     fn join(self, other: CurveExtremes) -> CurveExtremes {
@@ -187,6 +203,14 @@ impl CurveExtremes {
 }
 
 impl TransmissionError {
+    /// The same curves at crank angles `shift` \[rad\] later.
+    fn shift_crank_angles(&mut self, shift: f64) {
+        for a in &mut self.crank_angle {
+            *a += shift;
+        }
+        self.extremes.shift(shift);
+    }
+
     /// `next` (the following crank angles of the same curves) appended.
     fn join(&mut self, next: TransmissionError) {
         self.periods += next.periods;
@@ -705,6 +729,10 @@ impl Ltca {
         // A pin counts as loaded above round-off: at zero torque the unmodified profile touches
         // pins with forces of 1e-15 N, which were counted (and exported for FEA).
         let loaded_above = LOADED_FRACTION * (torque.abs() / st.scale[0]).max(1.0);
+        // Forces within the round-off floor of the force evaluation (Newton's, newton.rs) are
+        // round-off, not contact: at zero torque the physical preset touched 7-8 pins per disc
+        // with 1e-8 N, which were counted and exported for FEA. They are reported as 0.
+        let round_off = 4.0 * f64::EPSILON * self.k_ref * st.scale[0];
         let mut rot = Vec::new();
         let mut angles = Vec::new();
         let mut disp = Vec::new();
@@ -720,6 +748,7 @@ impl Ltca {
             for j in 0..zp {
                 let jet = &cs.pin_jet[kd * zp + j];
                 let f = cs.pin_force[kd * zp + j];
+                let f = if f > round_off { f } else { 0.0 };
                 if -jet.gap > max_pen {
                     return Err(RvdynError::Convergence(format!(
                         "at crank angle {psi:.6} rad and torque {torque:.6e} N m pin {} on disc \
@@ -830,6 +859,13 @@ impl Ltca {
             "crank angles over the periods",
             points.saturating_mul(periods),
         )?;
+        require_finite("start", start)?;
+        // The TE is a scalar of a state that repeats (turned about the axis) every window:
+        // solved from the start reduced into the first window, where the poses' angles are
+        // small and Newton's round-off floor is that of the first turns; the crank angles
+        // reported are the caller's.
+        let shift = start - start.rem_euclid(self.te_window);
+        let start = start - shift;
         // Each period as the one-period analysis from its own start (its sweeps from the
         // kinematic pose, its extremes located within it), then joined.
         let period = self.mesh_period;
@@ -838,6 +874,9 @@ impl Ltca {
             let next =
                 self.te_one_period(torque, light, points, start + k as f64 * period, pin_loads)?;
             all.join(next);
+        }
+        if shift != 0.0 {
+            all.shift_crank_angles(shift);
         }
         Ok(all)
     }
@@ -992,6 +1031,24 @@ impl Ltca {
     /// As [`Ltca::twist_loop`]; `friction = false` ignores the scene's friction (the closed
     /// loop of the frictionless reducer).
     pub fn twist_loop_with(
+        &mut self,
+        rated: f64,
+        psi: f64,
+        points: usize,
+        friction: bool,
+    ) -> Result<TwistLoop> {
+        require_finite("crank angle", psi)?;
+        // The loop's torques and twists are scalars of a state that repeats (turned about the
+        // axis) every window: solved at the crank angle reduced into the first window, where
+        // Newton's round-off floor is that of the first turns (at a few hundred radians it
+        // failed at the loop's near-zero torques); reported at the caller's.
+        let reduced = psi.rem_euclid(self.te_window);
+        let mut out = self.twist_loop_reduced(rated, reduced, points, friction)?;
+        out.crank_angle = psi;
+        Ok(out)
+    }
+
+    fn twist_loop_reduced(
         &mut self,
         rated: f64,
         psi: f64,

@@ -411,6 +411,16 @@ pub fn equilibrium(
     // accept the kinematic pose as converged (1e-7 N m on the physical preset returned TE 0
     // instead of the clearances' take-up).
     if load > 0.0 && load < MIN_LOAD_OVER_FLOOR * floor {
+        if size > 10.0 * rp {
+            // The floor is the large crank angle's, not the torque's.
+            return Err(RvdynError::Parameter(format!(
+                "at crank angle {psi} rad the bodies are turned so far that their positions \
+                 lose digits: the torque {torque:.3e} N m is within {MIN_LOAD_OVER_FLOOR} times \
+                 the round-off of the contact forces there; reduce the crank angle by whole \
+                 mesh periods (the equilibria repeat; transmission_error and torque_twist do \
+                 this themselves) or raise the torque"
+            )));
+        }
         return Err(RvdynError::Parameter(format!(
             "the torque {torque:.3e} N m is too small to resolve: its load scale |T|/rp = \
              {load:.3e} N is within {MIN_LOAD_OVER_FLOOR} times the round-off of the contact \
@@ -670,9 +680,9 @@ pub fn equilibrium(
 }
 
 fn not_converged(psi: f64, torque: f64, residual: f64, it: usize) -> RvdynError {
-    // Beyond about 1e3 rad the round-off of whole turns in the positions can exceed the
+    // Beyond about 1e2 rad (small torques) to 1e4 rad (rated) the round-off of whole turns in the positions can exceed the
     // tolerance (docs/model.md, "Newton iteration").
-    let turns = if psi.abs() > 1e3 {
+    let turns = if psi.abs() > 1e2 {
         " Or the crank angle is so large that the round-off of its whole turns exceeds the \
          tolerance: give it modulo the mesh period (the TE repeats)."
     } else {
