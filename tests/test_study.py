@@ -362,6 +362,35 @@ def test_sobol_indices_of_an_additive_model() -> None:
     assert np.isnan(failed.values).all() and np.isnan(failed.total).all() and failed.intervals == ()
 
 
+DELTAS: list[float] = []
+
+
+def offset_product_metric(scene: rvdyn.Scene) -> dict[str, float]:
+    """y = (d_delta / 1e-6) * d_rrp / 1e-5 + d_rp / 1e-5: the d_rrp sensitivity scales with d_delta."""
+    DELTAS.append(scene["cycloid.d_delta"])
+    return {"y": scene["cycloid.d_delta"] / 1e-6 * scene["cycloid.d_rrp"] / 1e-5 + scene["cycloid.d_rp"] / 1e-5}
+
+
+def test_sobol_applies_a_fixed_offset_like_the_study() -> None:
+    # A zero-width band (lower == upper = +2 um) is a fixed offset: study() evaluates d_delta at
+    # nominal + 2 um; sobol() evaluated it at the nominal 0, i.e. the indices of another design
+    # (here S_d_rrp = 0 instead of 4/7).
+    tols = TOLS + [Tolerance("cycloid.d_delta", lower=2e-6, upper=2e-6)]
+    t = rvdyn.study(SCENE, offset_product_metric, tols, samples=4, seed=1, runner=1)
+    assert (t["cycloid.d_delta"] == 2e-6).all()
+    DELTAS.clear()
+    s = rvdyn.study.sobol(SCENE, FunctionKernel(offset_product_metric, ("y",)), tols, 1024, "y", seed=3, runner=1,
+                          confidence=None)
+    assert set(DELTAS) == {2e-6}
+    # y = 2 x1 + x2 (x1 normal, sd 1/3; x2 uniform on [-2, 0], variance 1/3): additive, so
+    # S_i = ST_i = a_i^2 var_i / sum a_j^2 var_j = 4/7 and 3/7 (estimator noise ~0.02 at n = 1024).
+    v1, v2 = 4.0 / 9.0, 1.0 / 3.0
+    expected = {"cycloid.d_rrp": v1 / (v1 + v2), "cycloid.d_rp": v2 / (v1 + v2)}
+    assert set(s.names) == set(expected)
+    for name, val, tot in zip(s.names, s.values, s.total):
+        assert abs(val - expected[name]) < 0.05 and abs(tot - expected[name]) < 0.05
+
+
 def test_describe_bootstrap_intervals() -> None:
     t = rvdyn.study(SCENE, linear_metric, TOLS, samples=300, seed=1)
     d = rvdyn.study.describe(t, n_resamples=500)["y"]

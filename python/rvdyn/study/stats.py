@@ -266,7 +266,9 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
     dists = [layout.variables[j].scipy_dist() for j in keep]
     if not dists:
         raise ParameterError("sobol: every tolerance band is zero")
-    nominal = np.array([v.nominal for v in layout.variables])
+    # A zero-width band is a fixed offset: its variable stays at nominal + lower in every
+    # sample, as in study() and design() (Variable.ppf of a zero-width band).
+    fixed = np.array([v.nominal + 0.5 * (v.lower + v.upper) for v in layout.variables])
     mapper = resolve_runner(runner)
     task = Task(scene, k, layout, 1, os.getpid())
     fn = functools.partial(evaluate_batch, task)
@@ -274,7 +276,7 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
     failed = [0]
 
     def func(xs: np.ndarray) -> np.ndarray:
-        full = np.tile(nominal[:, None], (1, xs.shape[1]))
+        full = np.tile(fixed[:, None], (1, xs.shape[1]))
         full[keep] = xs
         rows = full.T
         batches = [[(i, rows[i].tolist()) for i in range(b, min(b + batch_size, len(rows)))]
