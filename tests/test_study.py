@@ -500,6 +500,54 @@ def test_spec_mistakes_are_one_line_errors_and_dotted_changes_change_one_field(t
     assert not os.path.exists(out)
 
 
+@pytest.mark.parametrize("kwargs, match", [
+    # A string bound passed float() and crashed the statistics after the whole study had run.
+    ({"criteria": [Criterion("y", max="1e5")]}, r"criterion on 'y': max must be a number, got '1e5'"),
+    ({"criteria": [{"metric": "y", "min": True}]}, r"criterion on 'y': min must be a number, got True"),
+    # These escaped as a bare ValueError (float('high'), a ragged numpy array).
+    ({"correlations": [Correlation(("cycloid.d_rrp", "cycloid.d_rp"), rho="high")]},
+     r"correlation \['cycloid.d_rrp', 'cycloid.d_rp'\]: rho must be a number"),
+    ({"correlations": [Correlation(("cycloid.d_rrp", "cycloid.d_rp"), matrix=[[1, 0.5], [0.5]])]},
+     r"correlation \['cycloid.d_rrp', 'cycloid.d_rp'\]: matrix must be 2x2"),
+    ({"correlations": [{"paths": 5, "rho": 0.5}]}, "paths must be a list"),
+    # tol = True was a +-1 m band.
+    ({"tolerances": [Tolerance("cycloid.d_rrp", tol=True)]}, r"'cycloid.d_rrp': tol must be a number.*got True"),
+    ({"tolerances": [Tolerance("cycloid.d_rrp", lower="-1e-5", upper=0.0)]}, r"lower must be a number"),
+])
+def test_mistyped_values_are_refused_before_any_sample_runs(kwargs: dict[str, Any], match: str) -> None:
+    args: dict[str, Any] = {"tolerances": TOLS, **kwargs}
+    CALLS.clear()
+    with pytest.raises(rvdyn.ParameterError, match=match):
+        rvdyn.study(SCENE, FunctionKernel(counting_metric, ("y",)), samples=4, runner=1, **args)
+    assert CALLS == []
+
+
+@pytest.mark.parametrize("text, match", [
+    ('[[criteria]]\nmetric = "peak_pin_force"\nmax = "1e5"', "criterion on 'peak_pin_force': max must be a number"),
+    ('[[correlations]]\npaths = ["cycloid.d_rrp", "cycloid.d_rp"]\nrho = "high"', "rho must be a number"),
+    ('[[correlations]]\npaths = ["cycloid.d_rrp", "cycloid.d_rp"]\nmatrix = [[1, 0.5], [0.5]]', "matrix must be 2x2"),
+    ('[[tolerances]]\npath = "cycloid.eccentricity"\ntol = true', "'cycloid.eccentricity': tol must be a number"),
+    ('[runner]\nkind = "dask"\nworkers = 0', r"\[runner\] workers must be a positive integer.*got 0"),
+    ('[runner]\nkind = "processes"\nworkers = 1.5', r"\[runner\] workers must be a positive integer.*got 1.5"),
+    ('[runner]\nkind = "mpi"', r"\[runner\] kind must be"),
+])
+def test_mistyped_spec_values_are_one_line_errors_before_the_study_runs(
+        tmp_path: os.PathLike[str], capsys: pytest.CaptureFixture[str], text: str, match: str) -> None:
+    from rvdyn.cli import main
+
+    spec = os.path.join(tmp_path, "s.toml")
+    out = os.path.join(tmp_path, "out")
+    with open(spec, "w", encoding="utf-8") as f:
+        f.write('[kernel]\nname = "ltca"\n[sampling]\nsamples = 2\n[[tolerances]]\npath = "cycloid.d_rrp"\n'
+                f'tol = 1e-5\n[[tolerances]]\npath = "cycloid.d_rp"\ntol = 1e-5\n{text}\n[output]\ndir = "{out}"\n')
+    assert main(["study", spec, "--no-plots"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("rvdyn study: ParameterError: "), err
+    import re
+    assert re.search(match, err[0]), err[0]
+    assert not os.path.exists(out)  # nothing ran (the criterion string failed after the study, table written)
+
+
 def scene_named_metrics(scene: rvdyn.Scene) -> dict[str, float]:
     """Metrics named like scene paths ("force.max" is dotted, "density" a scene field)."""
     return {"force.max": 3.0 * scene["cycloid.d_rrp"] / 1e-5, "density": 7850.0 + scene["cycloid.d_rp"] / 1e-5}
