@@ -168,6 +168,40 @@ def test_failed_samples_are_rows_with_their_error() -> None:
     assert t["y"][bad].isna().all() and (t["error"][~bad] == "").all()
 
 
+def nan_metric(scene: rvdyn.Scene) -> dict[str, float]:
+    """y is NaN for positive d_rrp and infinite for d_rp < -1e-5, without an exception; z is finite."""
+    d = scene["cycloid.d_rrp"]
+    return {"y": math.nan if d > 0 else (math.inf if scene["cycloid.d_rp"] < -1e-5 else d), "z": 1.0}
+
+
+def test_a_metric_that_is_not_finite_fails_its_sample_by_name() -> None:
+    # The rows had error == "", so the CLI printed "0 failed" while every such sample was rejected.
+    t = rvdyn.study(SCENE, nan_metric, TOLS, samples=40, seed=0, runner=2)
+    nan = t["cycloid.d_rrp"] > 0
+    inf = ~nan & (t["cycloid.d_rp"] < -1e-5)
+    assert nan.any() and inf.any() and (~nan & ~inf).any()
+    assert t["error"][nan].str.fullmatch(r"metric y is not finite: nan \(.*\)").all()
+    assert t["error"][inf].str.fullmatch(r"metric y is not finite: inf \(.*\)").all()
+    assert (t["error"][~nan & ~inf] == "").all()
+    assert (t["z"] == 1.0).all()  # the finite metric keeps its value
+    assert rvdyn.study.describe(t, n_resamples=50)["y"]["failed"] == int((nan | inf).sum())
+
+
+def test_cli_counts_a_not_finite_metric_as_failed(tmp_path: os.PathLike[str], capsys: pytest.CaptureFixture[str]) -> None:
+    from rvdyn.cli import main
+
+    # The input does not turn: the dynamic kernel's output_speed_error is NaN (0/0).
+    spec = os.path.join(tmp_path, "s.toml")
+    with open(spec, "w", encoding="utf-8") as f:
+        f.write('[scene]\nchanges = { drive.speed = 0.0 }\n[kernel]\nname = "dynamic"\nt_end = 0.01\n'
+                '[sampling]\nsamples = 2\n[[tolerances]]\npath = "cycloid.d_rrp"\ntol = 1e-5\n'
+                '[[criteria]]\nmetric = "output_speed_error"\nmax = 0.01\n[runner]\nworkers = 1\n')
+    assert main(["study", spec, "--no-plots", "--out", os.path.join(tmp_path, "o")]) == 1
+    cap = capsys.readouterr()
+    assert "2 samples, 2 failed" in cap.out
+    assert "the first: metric output_speed_error is not finite: nan" in cap.err
+
+
 # ---------------------------------------------------------------------------------- ltca kernel
 PIN_TOLS = [Tolerance("pin_errors.radius", tol=5e-6)]
 
@@ -357,9 +391,27 @@ def test_sobol_indices_of_an_additive_model() -> None:
     assert rvdyn.study.sobol(SCENE, linear_metric, TOLS, 64, "y", seed=3, runner=1).intervals == again.intervals
     none = rvdyn.study.sobol(SCENE, linear_metric, TOLS, 64, "y", seed=3, runner=1, confidence=None)
     assert none.intervals == ()
-    # Failed samples: SciPy reads their NaN as 0 and reported indices of 0 (no sensitivity).
-    failed = rvdyn.study.sobol(SCENE, failing_metric, TOLS, 16, "y", seed=3, runner=1)
-    assert np.isnan(failed.values).all() and np.isnan(failed.total).all() and failed.intervals == ()
+
+
+def test_sobol_with_failed_samples_or_an_unknown_metric_says_so() -> None:
+    # Failed samples made every index NaN without a word (SciPy would read the NaN as 0); now
+    # the count and the first error, after the first matrix of runs (16 of 64 here).
+    with pytest.raises(rvdyn.study.RunnerError,
+                       match=r"sobol: \d+ of the 16 samples run so far \(of 64\) failed; the first: "
+                             r"SimulationError: d_rrp > 0"):
+        rvdyn.study.sobol(SCENE, failing_metric, TOLS, 16, "y", seed=3, runner=1)
+    # A metric that is not finite fails its sample the same way.
+    with pytest.raises(rvdyn.study.RunnerError, match="the first: metric y is not finite"):
+        rvdyn.study.sobol(SCENE, nan_metric, TOLS, 16, "y", seed=3, runner=1)
+    # A misspelled metric: before any run when the kernel declares its metrics ...
+    CALLS.clear()
+    with pytest.raises(rvdyn.ParameterError, match=r"sobol: unknown metric 'Y'; the kernel gives \['y'\]"):
+        rvdyn.study.sobol(SCENE, FunctionKernel(counting_metric, ("y",)), TOLS, 16, "Y", runner=1)
+    assert CALLS == []
+    # ... else after the first batch (one run), not the n (d + 2) = 64 runs.
+    with pytest.raises(rvdyn.ParameterError, match=r"sobol: unknown metric 'Y'; the kernel gives \['y'\]"):
+        rvdyn.study.sobol(SCENE, counting_metric, TOLS, 16, "Y", runner=1)
+    assert len(CALLS) == 1
 
 
 DELTAS: list[float] = []

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import concurrent.futures
 import functools
+import math
 import os
 import pickle
 import traceback
@@ -42,9 +43,13 @@ Record = tuple[int, dict[str, float], str]
 
 
 class RunnerError(RvdynError, RuntimeError):
-    """The runner lost every task of a chunk (a broken process pool, workers that keep dying):
-    the study stops. The rows so far (the lost ones with their error) are on disk when the study
-    has ``out``; running it again resumes (``retry_failed=True`` reruns the lost samples)."""
+    """Samples that could not be evaluated stop the computation.
+
+    In :func:`rvdyn.study.run`: the runner lost every task of a chunk (a broken process pool,
+    workers that keep dying). The rows so far (the lost ones with their error) are on disk when
+    the study has ``out``; running it again resumes (``retry_failed=True`` reruns the lost
+    samples). In :func:`rvdyn.study.sobol`: a sample of the Saltelli design failed (the
+    message gives how many and the first error)."""
 
 
 @dataclass(frozen=True)
@@ -71,17 +76,27 @@ def _configure_worker(threads: int) -> None:
 
 def evaluate(task: Task, sample: tuple[int, Sequence[float]]) -> Record:
     """Evaluate one sample ``(id, values)``: set the toleranced fields of the scene and run the
-    kernel. Any exception becomes the record's error message (the study goes on)."""
+    kernel. Any exception becomes the record's error message (the study goes on); so does a
+    metric that is NaN or infinite ("metric <name> is not finite: nan ..."; the other metrics
+    keep their values)."""
     sid, values = sample
     try:
         scene = apply_values(task.scene, task.layout, np.asarray(values, dtype=float))
-        metrics = task.kernel(scene)
-        return int(sid), {str(k): float(v) for k, v in metrics.items()}, ""
+        metrics = {str(k): float(v) for k, v in task.kernel(scene).items()}
     except Exception as exc:  # noqa: BLE001 - a failed sample is a row, whatever failed
         msg = f"{type(exc).__name__}: {exc}".strip()
         if not isinstance(exc, ValueError | ArithmeticError | RuntimeError):
             msg += " | " + traceback.format_exc(limit=3).replace("\n", " ")[-400:]
         return int(sid), {}, msg
+    # A metric that came back NaN or infinite without an exception (e.g. the dynamic kernel's
+    # output_speed_error when the input does not turn) makes the sample a failed one: counted
+    # with the failures and named, instead of a silent NaN. The finite metrics keep their values.
+    bad = [k for k, v in metrics.items() if not math.isfinite(v)]
+    if bad:
+        return int(sid), metrics, (f"metric{'s' if len(bad) > 1 else ''} {', '.join(bad)} "
+                                   f"{'are' if len(bad) > 1 else 'is'} not finite: "
+                                   f"{', '.join(str(metrics[k]) for k in bad)} (returned by the kernel without an error)")
+    return int(sid), metrics, ""
 
 
 def evaluate_batch(task: Task, batch: Sequence[tuple[int, Sequence[float]]]) -> list[Record]:

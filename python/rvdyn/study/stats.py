@@ -240,13 +240,18 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
     level ``confidence`` (None: none) from ``n_resamples`` resamples (SciPy's BCa bootstrap of
     the Saltelli design; ``seed`` fixes the design, the indices and the resamples, so a seeded
     call repeats to the last digit; ``seed=None`` varies the interval ends by about
-    1/sqrt(n_resamples) between calls). Independent tolerances only; a failed
-    sample (or a metric the kernel does not give) makes every index NaN and leaves out the
-    intervals: SciPy would read the NaN outputs as 0 and report no sensitivity at all."""
+    1/sqrt(n_resamples) between calls). Independent tolerances only.
+
+    Every run of the design is needed (SciPy would read a missing output as 0 and report no
+    sensitivity at all): a sample that fails (its kernel raised, or returned a metric that is
+    not finite) raises :class:`rvdyn.study.RunnerError` with the number of failed samples and
+    the first error, as soon as the batch of runs that holds it has finished. A ``metric``
+    that the kernel does not give is a :class:`rvdyn.ParameterError` listing the metrics it
+    gives: before any run when the kernel declares its metrics, else after the first batch."""
     from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     from .kernels import get_kernel
-    from .runners import Task, _Failure, evaluate_batch, resolve_runner
+    from .runners import RunnerError, Task, _Failure, evaluate_batch, resolve_runner
     from .spec import expand
     import functools
     import os
@@ -261,7 +266,7 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
     layout = expand(scene, tolerances)
     metrics = getattr(k, "metrics", None)
     if metrics is not None and metric not in metrics:
-        raise ParameterError(f"unknown metric {metric!r}; the kernel gives {list(metrics)}")
+        raise ParameterError(f"sobol: unknown metric {metric!r}; the kernel gives {list(metrics)}")
     keep = [j for j, v in enumerate(layout.variables) if v.upper > v.lower]
     dists = [layout.variables[j].scipy_dist() for j in keep]
     if not dists:
@@ -273,7 +278,24 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
     task = Task(scene, k, layout, 1, os.getpid())
     fn = functools.partial(evaluate_batch, task)
 
-    failed = [0]
+    total_runs = n * (len(keep) + 2)
+    runs = [0]
+    failed: list[str] = []
+    checked = [metrics is not None]
+
+    def run_rows(batches: list[list[tuple[int, list[float]]]], out: np.ndarray) -> None:
+        for batch, res in zip(batches, mapper.run(fn, batches)):
+            if isinstance(res, _Failure):
+                failed.extend(res.message for _ in batch)
+                continue
+            for sid, m, err in res:
+                if err:
+                    failed.append(err)
+                    continue
+                if metric not in m:
+                    raise ParameterError(f"sobol: unknown metric {metric!r}; the kernel gives {sorted(m)}")
+                checked[0] = True
+                out[sid] = m[metric]
 
     def func(xs: np.ndarray) -> np.ndarray:
         full = np.tile(fixed[:, None], (1, xs.shape[1]))
@@ -282,11 +304,17 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
         batches = [[(i, rows[i].tolist()) for i in range(b, min(b + batch_size, len(rows)))]
                    for b in range(0, len(rows), batch_size)]
         out = np.full(len(rows), np.nan)
-        for batch, res in zip(batches, mapper.run(fn, batches)):
-            if not isinstance(res, _Failure):
-                for sid, m, _ in res:
-                    out[sid] = m.get(metric, np.nan)
-        failed[0] += int(np.count_nonzero(~np.isfinite(out)))
+        if not checked[0]:  # one batch first: a misspelled metric costs one batch, not n (d + 2) runs
+            run_rows(batches[:1], out)
+            batches = batches[1:]
+        run_rows(batches, out)
+        runs[0] += len(rows)
+        if failed:
+            raise RunnerError(
+                f"sobol: {len(failed)} of the {runs[0]} samples run so far (of {total_runs}) failed; the first: "
+                f"{failed[0]}. Sobol indices need every run of the Saltelli design: narrow the tolerances to "
+                "the range where the kernel works, or fix the kernel (rvdyn.study(...) records each failure "
+                "as a row and src() ranks the samples that ran)")
         return out[None, :]
 
     try:
@@ -295,9 +323,6 @@ def sobol(scene: Any, kernel: Any, tolerances: Sequence[Any], n: int, metric: st
         mapper.close()
     first = np.asarray(res.first_order).ravel()
     total = np.asarray(res.total_order).ravel()
-    if failed[0]:
-        first = np.full(first.shape, np.nan)
-        total = np.full(total.shape, np.nan)
     names = [layout.variables[j].column for j in keep]
     order = np.argsort(-np.abs(first), kind="stable")
     intervals: tuple[tuple[float, float, float, float], ...] = ()
