@@ -456,6 +456,45 @@ def test_describe_bootstrap_intervals() -> None:
     assert abs((d["mean"].high - d["mean"].low) / (2 * half) - 1) < 0.2
 
 
+def test_describe_tail_intervals_cover_at_their_level() -> None:
+    """Coverage of the nominal 95 % intervals over 200 seeded replicates of 64 normal values (the
+    guide's study size). The percentile bootstrap covered p5 and p95 only ~82-84 % of the time
+    here; BCa (Efron & Tibshirani 1993, ch. 14) ~93-96 %. The bound 0.9 lies
+    ~2.7 Monte-Carlo standard errors (sqrt(0.95 * 0.05 / 200) = 0.015) below 0.95 and ~4 above
+    the percentile bootstrap's coverage; the seeds make the count exact, so the test is
+    deterministic (it takes about half a second)."""
+    from scipy import stats
+
+    rng = np.random.default_rng(2024)
+    true = {"mean": 0.0, "std": 1.0, "p5": float(stats.norm.ppf(0.05)), "p50": 0.0,
+            "p95": float(stats.norm.ppf(0.95))}
+    covered = dict.fromkeys(true, 0)
+    replicates = 200
+    for r in range(replicates):
+        d = rvdyn.study.describe({"y": rng.normal(size=64)}, n_resamples=999, seed=r)["y"]
+        for k, v in true.items():
+            covered[k] += d[k].low <= v <= d[k].high
+    assert all(c / replicates >= 0.9 for c in covered.values()), covered
+
+
+def test_describe_degenerate_data_has_documented_intervals() -> None:
+    # pytest turns warnings into errors: SciPy's DegenerateDataWarning and numpy's 0/0 must not leak.
+    d = rvdyn.study.describe({"y": np.full(10, 4.0)})["y"]
+    assert all((d[k].value, d[k].low, d[k].high) == ((0.0, 0.0, 0.0) if k == "std" else (4.0, 4.0, 4.0))
+               for k in ("mean", "std", "p5", "p50", "p95"))
+    for x in ([1.0], [1.0, 2.0]):  # fewer than MIN_BOOTSTRAP_SAMPLES = 3 values: no interval
+        d = rvdyn.study.describe({"y": np.array(x)})["y"]
+        assert d["n"] == len(x) and d["mean"].value == np.mean(x)
+        assert all(math.isnan(d[k].low) and math.isnan(d[k].high) for k in ("mean", "std", "p5", "p50", "p95"))
+    # An integer-valued metric (loaded pins): BCa is undefined for its median (every jackknife
+    # value equal); the percentile interval of the same resamples stands in, finite and bracketing.
+    y = np.array([10.0] * 60 + [9.0] * 4)
+    d = rvdyn.study.describe({"y": y})["y"]
+    for k in ("mean", "std", "p5", "p50", "p95"):
+        assert math.isfinite(d[k].low) and d[k].low <= d[k].value <= d[k].high, (k, d[k])
+    assert (d["p50"].low, d["p50"].high) == (10.0, 10.0)
+
+
 def test_plots_draw_criterion_and_bars() -> None:
     import matplotlib
 

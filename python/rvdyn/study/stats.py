@@ -1,11 +1,14 @@
 """Statistics of a study table: summaries with bootstrap confidence intervals, yield against
 pass criteria, sensitivity rankings.
 
-* Percentile bootstrap (Efron & Tibshirani 1993, *An Introduction to the Bootstrap*, ch. 13)
-  via :func:`scipy.stats.bootstrap` for the mean, the standard deviation and percentiles.
+* Bias-corrected and accelerated (BCa) bootstrap intervals (Efron & Tibshirani 1993, *An
+  Introduction to the Bootstrap*, ch. 14) via :func:`scipy.stats.bootstrap` for the mean, the
+  standard deviation and percentiles (the percentile bootstrap under-covers tail percentiles
+  at a few dozen samples: ~83 % for a nominal 95 % p95 at n = 64).
 * Yield = fraction of samples meeting every criterion, with the Wilson score interval (Wilson
-  1927) or the exact Clopper-Pearson interval (Clopper & Pearson 1934) from
-  :meth:`scipy.stats.binomtest(...).proportion_ci`. A failed sample counts as not passing.
+  1927), with or without continuity correction, or the exact Clopper-Pearson interval
+  (Clopper & Pearson 1934) from :meth:`scipy.stats.binomtest(...).proportion_ci`. A failed
+  sample counts as not passing.
 * Standardised regression coefficients SRC_i = b_i s_i / s_y of the linear least-squares fit of
   the metric on the inputs (Saltelli et al. 2008, *Global Sensitivity Analysis: The Primer*,
   Wiley, sec. 1.2.5): for a linear model with independent inputs SRC_i^2 is the share of the
@@ -20,6 +23,7 @@ from __future__ import annotations
 
 import inspect
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Any, Sequence
 
@@ -104,12 +108,24 @@ def _summary_stat(qs: Sequence[float]) -> Any:
     return stat
 
 
+#: Fewest samples with a finite value for a bootstrap interval (BCa's jackknife of the standard
+#: deviation needs subsamples of two): below it every interval is NaN.
+MIN_BOOTSTRAP_SAMPLES = 3
+
+
 def describe(table: Any, metrics: Sequence[str] | None = None, percentiles: Sequence[float] = (5.0, 50.0, 95.0),
              confidence: float = 0.95, n_resamples: int = 1000, seed: int | None = 0) -> dict[str, dict[str, Any]]:
     """Per metric: ``n`` (samples with a finite value), ``failed`` (samples without one: the
     analysis failed, or returned an infinite or undefined value), ``mean``, ``std`` (ddof 1) and
-    each percentile ``"p<q>"`` as :class:`Interval` s: percentile bootstrap intervals, all
-    statistics from the same ``n_resamples`` resamples."""
+    each percentile ``"p<q>"`` as :class:`Interval` s with bias-corrected and accelerated (BCa)
+    bootstrap intervals (Efron & Tibshirani 1993, ch. 14; :func:`scipy.stats.bootstrap`), all
+    statistics from the same ``n_resamples`` resamples.
+
+    Degenerate data: with fewer than :data:`MIN_BOOTSTRAP_SAMPLES` values every interval is
+    ``[nan, nan]``; with all values equal every interval is ``[v, v]`` (each resample is the same
+    data). A statistic whose BCa interval is undefined (its jackknife values all equal, as for
+    the median of an integer-valued metric such as ``loaded_pins_min``) gets the percentile
+    interval of the same resamples."""
     from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     cols = columns(table)
@@ -132,13 +148,27 @@ def describe(table: Any, metrics: Sequence[str] | None = None, percentiles: Sequ
         if len(x) == 0:
             continue
         value = stat(x)
-        if len(x) < 2 or np.ptp(x) == 0:
+        if len(x) < MIN_BOOTSTRAP_SAMPLES:
+            low = high = np.full(len(keys), np.nan)
+        elif np.ptp(x) == 0:
             low = high = value
         else:
-            res = stats.bootstrap((x,), stat, n_resamples=n_resamples, confidence_level=confidence,
-                                  method="percentile", vectorized=True, batch=max(1, int(2e6 // len(x))),
-                                  **_rng_kw(stats.bootstrap, seed))
-            low, high = np.asarray(res.confidence_interval.low), np.asarray(res.confidence_interval.high)
+            with warnings.catch_warnings(), np.errstate(all="ignore"):
+                # BCa is undefined for a statistic whose jackknife values are all equal: SciPy
+                # warns and gives NaN, replaced below by the percentile interval.
+                warnings.simplefilter("ignore", stats.DegenerateDataWarning)
+                warnings.simplefilter("ignore", RuntimeWarning)
+                res = stats.bootstrap((x,), stat, n_resamples=n_resamples, confidence_level=confidence,
+                                      method="BCa", vectorized=True, batch=max(1, int(2e6 // len(x))),
+                                      **_rng_kw(stats.bootstrap, seed))
+            low = np.array(res.confidence_interval.low, dtype=float)
+            high = np.array(res.confidence_interval.high, dtype=float)
+            bad = ~(np.isfinite(low) & np.isfinite(high))
+            if bad.any():
+                alpha = 100.0 * (1.0 - confidence) / 2.0
+                dist = np.asarray(res.bootstrap_distribution)[bad]
+                low[bad] = np.percentile(dist, alpha, axis=-1)
+                high[bad] = np.percentile(dist, 100.0 - alpha, axis=-1)
         for k, key in enumerate(keys):
             entry[key] = Interval(float(value[k]), float(low[k]), float(high[k]), confidence)
     return out
@@ -158,8 +188,8 @@ class YieldResult:
 def yield_rate(table: Any, criteria: Sequence[Criterion | dict[str, Any]], confidence: float = 0.95,
                method: str = "wilson") -> YieldResult:
     """Fraction of samples meeting all ``criteria`` with a binomial confidence interval:
-    ``method="wilson"`` (score interval) or ``"exact"`` (Clopper-Pearson). Failed samples count
-    as not passing."""
+    ``method="wilson"`` (score interval), ``"wilsoncc"`` (score interval with continuity
+    correction) or ``"exact"`` (Clopper-Pearson). Failed samples count as not passing."""
     from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     if method not in ("wilson", "exact", "wilsoncc"):
