@@ -353,6 +353,28 @@ def test_yield_matches_the_wilson_interval() -> None:
         rvdyn.study.yield_rate(table, [Criterion("z", max=1.0)])
 
 
+def test_samples_lost_by_the_runner_are_left_out_of_the_statistics_with_a_warning() -> None:
+    # A broken pool's rows counted as rejected parts: the yield fell with every lost sample.
+    y = np.array([0.1, 0.5, np.nan, 1.2, np.nan, 0.7, np.nan, 0.2])
+    error = np.array(["", "", "SimulationError: no equilibrium", "", "runner failed: BrokenProcessPool: ...",
+                      "", "runner failed: KilledWorker: ...", ""])
+    table = {"sample": np.arange(8), "y": y, "error": error}
+    with pytest.warns(rvdyn.study.RunnerFailureWarning,
+                      match=r"2 of 8 samples were lost by the runner.*BrokenProcessPool.*retry_failed=True"):
+        res = rvdyn.study.yield_rate(table, [Criterion("y", max=1.0)])
+    assert (res.passed, res.n) == (4, 6)  # the analysis failure still counts as not passing
+    with pytest.warns(rvdyn.study.RunnerFailureWarning):
+        d = rvdyn.study.describe(table, n_resamples=50)["y"]
+    assert (d["n"], d["failed"], d["lost"]) == (5, 1, 2)
+    with pytest.warns(rvdyn.study.RunnerFailureWarning), pytest.raises(rvdyn.ParameterError, match="lost every"):
+        rvdyn.study.yield_rate({**table, "error": np.array(["runner failed: x"] * 8)}, [Criterion("y", max=1.0)])
+    # wilsoncc (Wilson with continuity correction) is a documented method.
+    table["error"] = np.array([""] * 8)
+    cc = rvdyn.study.yield_rate(table, [Criterion("y", max=1.0)], method="wilsoncc")
+    plain = rvdyn.study.yield_rate(table, [Criterion("y", max=1.0)])
+    assert cc.method == "wilsoncc" and cc.rate.low < plain.rate.low and cc.rate.high > plain.rate.high
+
+
 def test_src_ranks_a_linear_model_exactly() -> None:
     t = rvdyn.study(SCENE, linear_metric, TOLS, samples=200, seed=9)
     s = rvdyn.study.src(t, "y")

@@ -213,7 +213,8 @@ def run_spec(path: str | Path, out: str | Path | None = None, samples: int | Non
     """Run the study of a spec file: writes ``results.parquet/`` (the table),
     ``statistics.json`` (summary, yield, sensitivity) and, with ``plots``, a histogram per
     metric and a sensitivity bar chart per metric into the output folder. Returns the
-    statistics."""
+    statistics: ``failed`` counts every row with an error, ``lost`` those the runner lost
+    (left out of the yield and summaries, with a ``RunnerFailureWarning``)."""
     from . import stats
     from .driver import run
     from .sampling import as_sampler
@@ -240,9 +241,12 @@ def run_spec(path: str | Path, out: str | Path | None = None, samples: int | Non
             runner.close()
             if cluster is not None:
                 cluster.close()
+    from .runners import RUNNER_FAILED
+
     summary = stats.describe(table)
     errors = table["error"][table["error"] != ""]
-    result: dict[str, Any] = {"samples": int(len(table)), "failed": int(len(errors)),
+    lost = sum(1 for e in errors if str(e).startswith(RUNNER_FAILED))
+    result: dict[str, Any] = {"samples": int(len(table)), "failed": int(len(errors)), "lost": lost,
                               "first_error": str(next(iter(errors))) if len(errors) else None,
                               "metrics": {m: {k: (v.__dict__ if isinstance(v, stats.Interval) else v)
                                               for k, v in e.items()} for m, e in summary.items()}}

@@ -8,7 +8,7 @@ pass criteria, sensitivity rankings.
 * Yield = fraction of samples meeting every criterion, with the Wilson score interval (Wilson
   1927), with or without continuity correction, or the exact Clopper-Pearson interval
   (Clopper & Pearson 1934) from :meth:`scipy.stats.binomtest(...).proportion_ci`. A failed
-  sample counts as not passing.
+  sample counts as not passing; a sample the runner lost is left out (with a warning).
 * Standardised regression coefficients SRC_i = b_i s_i / s_y of the linear least-squares fit of
   the metric on the inputs (Saltelli et al. 2008, *Global Sensitivity Analysis: The Primer*,
   Wiley, sec. 1.2.5): for a linear model with independent inputs SRC_i^2 is the share of the
@@ -85,6 +85,24 @@ def metric_names(table: Any) -> list[str]:
     return [c for c in columns(table) if c not in _RESERVED and not _is_input(c)]
 
 
+def _ran_rows(cols: dict[str, np.ndarray]) -> np.ndarray:
+    """Mask of the rows the runner did not lose; warns (:class:`RunnerFailureWarning`) when it lost
+    some: those samples were never evaluated, so they are neither passing nor failing parts."""
+    from .runners import RUNNER_FAILED, RunnerFailureWarning
+
+    n = len(next(iter(cols.values()))) if cols else 0
+    if "error" not in cols:
+        return np.ones(n, dtype=bool)
+    errors = [str(e) for e in cols["error"]]
+    lost = np.array([e.startswith(RUNNER_FAILED) for e in errors], dtype=bool)
+    if lost.any():
+        first = errors[int(np.argmax(lost))]
+        warnings.warn(f"{int(lost.sum())} of {n} samples were lost by the runner, not evaluated ({first[:200]}); "
+                      "the statistics (yield, summaries) leave them out: run the study again with the same "
+                      "out= and retry_failed=True to evaluate them", RunnerFailureWarning, stacklevel=3)
+    return ~lost
+
+
 @dataclass(frozen=True)
 class Interval:
     """An estimate with its confidence interval [low, high] at ``confidence``."""
@@ -125,7 +143,9 @@ def describe(table: Any, metrics: Sequence[str] | None = None, percentiles: Sequ
     ``[nan, nan]``; with all values equal every interval is ``[v, v]`` (each resample is the same
     data). A statistic whose BCa interval is undefined (its jackknife values all equal, as for
     the median of an integer-valued metric such as ``loaded_pins_min``) gets the percentile
-    interval of the same resamples."""
+    interval of the same resamples. Rows lost by the runner (``error`` starting with
+    ``"runner failed"``) are left out, with a :class:`rvdyn.study.RunnerFailureWarning`; their
+    count is ``lost``."""
     from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     cols = columns(table)
@@ -139,11 +159,12 @@ def describe(table: Any, metrics: Sequence[str] | None = None, percentiles: Sequ
     names = list(metrics) if metrics is not None else metric_names(table)
     keys = ["mean", "std"] + [f"p{q:g}" for q in percentiles]
     stat = _summary_stat(percentiles)
+    ran = _ran_rows(cols)
     out: dict[str, dict[str, Any]] = {}
     for name in names:
-        v = _metric(cols, name)
+        v = _metric(cols, name)[ran]
         x = v[np.isfinite(v)]
-        entry: dict[str, Any] = {"n": int(len(x)), "failed": int(len(v) - len(x))}
+        entry: dict[str, Any] = {"n": int(len(x)), "failed": int(len(v) - len(x)), "lost": int(len(ran) - ran.sum())}
         out[name] = entry
         if len(x) == 0:
             continue
@@ -189,7 +210,10 @@ def yield_rate(table: Any, criteria: Sequence[Criterion | dict[str, Any]], confi
                method: str = "wilson") -> YieldResult:
     """Fraction of samples meeting all ``criteria`` with a binomial confidence interval:
     ``method="wilson"`` (score interval), ``"wilsoncc"`` (score interval with continuity
-    correction) or ``"exact"`` (Clopper-Pearson). Failed samples count as not passing."""
+    correction) or ``"exact"`` (Clopper-Pearson). Samples whose analysis failed count as not
+    passing. Samples the runner lost (``error`` starting with ``"runner failed"``: the worker
+    died, the pool broke) were never evaluated: they are left out of ``n``, with a
+    :class:`rvdyn.study.RunnerFailureWarning`."""
     from scipy import stats  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     if method not in ("wilson", "exact", "wilsoncc"):
@@ -200,12 +224,16 @@ def yield_rate(table: Any, criteria: Sequence[Criterion | dict[str, Any]], confi
     crits = check_criteria(criteria, metric_names(table))
     if not crits:
         raise ParameterError("yield needs at least one criterion")
-    n = len(cols["sample"])
-    if n == 0:
+    if len(cols["sample"]) == 0:
         raise ParameterError("yield of an empty table")
+    ran = _ran_rows(cols)
+    n = int(ran.sum())
+    if n == 0:
+        raise ParameterError("yield: the runner lost every sample (each error starts with 'runner failed'); "
+                             "run the study again with the same out= and retry_failed=True")
     ok = np.ones(n, dtype=bool)
     for c in crits:
-        ok &= c.passes(_metric(cols, c.metric))
+        ok &= c.passes(_metric(cols, c.metric)[ran])
     k = int(ok.sum())
     ci = stats.binomtest(k, n).proportion_ci(confidence_level=confidence, method=method)
     return YieldResult(k, n, Interval(k / n, float(ci.low), float(ci.high), confidence), method, tuple(crits))
