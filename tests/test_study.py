@@ -323,6 +323,39 @@ def test_stream_to_parquet_and_resume(tmp_path: os.PathLike[str]) -> None:
         rvdyn.study(SCENE, kern, TOLS, samples=10, seed=6, out=out)
 
 
+def test_every_parquet_part_has_every_column_and_the_meta_describes_the_study(tmp_path: os.PathLike[str]) -> None:
+    pytest.importorskip("pyarrow")
+    import pandas as pd
+    import pyarrow.parquet as pq
+
+    # A plain function declares no metrics; when its first chunk failed, the first part had no
+    # metric column and pandas, which takes a folder's columns from one part, dropped y.
+    lay = expand(SCENE, TOLS)
+    seed = next(k for k in range(100) if (design(lay, MonteCarlo(8), k)[:2, 0] > 0).all()
+                and (design(lay, MonteCarlo(8), k)[:, 0] <= 0).sum() >= 2)
+    out = os.path.join(tmp_path, "s.parquet")
+    t = rvdyn.study(SCENE, failing_metric, TOLS, samples=8, seed=seed, runner=1, chunk_size=2, out=out)
+    assert (t["error"][:2] != "").all() and np.isfinite(t["y"]).sum() >= 2
+    parts = sorted(f for f in os.listdir(out) if f.startswith("part-"))
+    assert len(parts) == 4
+    assert all(pq.read_schema(os.path.join(out, f)).names == list(t.columns) for f in parts)
+    df = pd.read_parquet(out).sort_values("sample").reset_index(drop=True)
+    assert list(df.columns) == list(t.columns)
+    assert np.array_equal(df["y"].to_numpy(), t["y"].to_numpy(), equal_nan=True)
+    # _meta.json: units of the metrics (from the kernel), correlations and criteria.
+    out2 = os.path.join(tmp_path, "l.parquet")
+    rvdyn.study(SCENE, "ltca", TOLS, samples=2, runner=1, out=out2,
+                correlations=[Correlation(("cycloid.d_rrp", "cycloid.d_rp"), rho=0.5)],
+                criteria=[Criterion("peak_pin_force", max=5e4), {"metric": "lost_motion", "min": 0}])
+    meta = rvdyn.study.storage.read_meta(out2)
+    assert meta["metric_units"] == {"te_pp_forward": "rad", "te_pp_reverse": "rad", "peak_pin_force": "N",
+                                    "loaded_pins_min": "-", "torsional_rigidity": "N m/rad", "lost_motion": "rad"}
+    assert meta["input_paths"] == {"cycloid.d_rrp": "cycloid.d_rrp", "cycloid.d_rp": "cycloid.d_rp"}
+    assert meta["correlations"] == [{"columns": ["cycloid.d_rrp", "cycloid.d_rp"], "matrix": [[1.0, 0.5], [0.5, 1.0]]}]
+    assert meta["criteria"] == [{"metric": "peak_pin_force", "min": None, "max": 5e4},
+                                {"metric": "lost_motion", "min": 0.0, "max": None}]
+
+
 def test_retry_failed_reruns_only_failed_samples(tmp_path: os.PathLike[str]) -> None:
     pytest.importorskip("pyarrow")
     out = os.path.join(tmp_path, "f.parquet")
