@@ -210,8 +210,14 @@ class Mapper:
         window = 2 * self.workers
         while pending or inflight:
             while pending and len(inflight) < window:
-                i = pending.popleft()
-                inflight[self.runner.submit(fn, items[i])] = i
+                try:
+                    inflight[self.runner.submit(fn, items[pending[0]])] = pending[0]
+                except concurrent.futures.BrokenExecutor:
+                    break  # broke meanwhile: the tasks in it fail now and are handled below
+                pending.popleft()
+            if not inflight:  # broken with no task of ours in it
+                self._replace_pool()
+                continue
             done, _ = concurrent.futures.wait(inflight, return_when=concurrent.futures.FIRST_COMPLETED)
             if any(isinstance(f.exception(), concurrent.futures.BrokenExecutor) for f in done):
                 # The pool is broken: every task still in it ends now, finished or lost.
