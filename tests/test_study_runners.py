@@ -181,3 +181,52 @@ def test_dask_samples_that_always_kill_their_worker_are_rows(monkeypatch: pytest
         os.remove(marker)
         t2 = rvdyn.study(SCENE, kernel, tols, runner=client, retry_failed=True, **args)  # type: ignore[arg-type]
     assert list(t2["sample"]) == list(range(12)) and (t2["error"] == "").all()
+
+
+def crashing_metric(scene: rvdyn.Scene) -> dict[str, float]:
+    """Kills its worker process for every sample with d_rrp above 6e-6 m (a segfault or an
+    out-of-memory kill on that sample, whatever worker runs it)."""
+    if scene["cycloid.d_rrp"] > 6e-6:
+        os._exit(3)
+    return {"y": scene["cycloid.d_rrp"] / 1e-6}
+
+
+def _check_only_the_crashing_samples_are_lost(t: object) -> None:
+    import pandas as pd
+
+    assert isinstance(t, pd.DataFrame)
+    crash = t["cycloid.d_rrp"] > 6e-6
+    assert list(t["sample"]) == list(range(len(t))) and crash.any() and (~crash).sum() >= 30
+    assert t["error"][crash].str.startswith("runner failed: ").all()
+    assert (t["error"][~crash] == "").all()  # every other sample ran (34 of 40 were lost before)
+    # The lost samples are not rejected parts: the yield and the summaries leave them out, and say so.
+    with pytest.warns(rvdyn.study.RunnerFailureWarning, match=rf"{int(crash.sum())} of 40 samples were lost"):
+        y = rvdyn.study.yield_rate(t, [rvdyn.study.Criterion("y", max=10)])
+    assert (y.passed, y.n) == (int((~crash).sum()), int((~crash).sum()))
+    with pytest.warns(rvdyn.study.RunnerFailureWarning):
+        d = rvdyn.study.describe(t, n_resamples=50)["y"]
+    assert (d["n"], d["failed"], d["lost"]) == (int((~crash).sum()), 0, int(crash.sum()))
+
+
+CRASH_ARGS: dict[str, object] = dict(samples=LatinHypercube(40), seed=2)
+
+
+def test_a_crashing_sample_fails_alone_on_a_process_pool() -> None:
+    # The pool broke and every other sample of the chunk became a "runner failed" row (34 of
+    # 40), counted by the yield as rejected parts: 0.15 for a true 0.95. Now the pool is
+    # replaced and the lost tasks run again one at a time.
+    t = rvdyn.study(SCENE, FunctionKernel(crashing_metric, ("y",)), [Tolerance("cycloid.d_rrp", tol=1e-5)],
+                    runner="processes:2", **CRASH_ARGS)  # type: ignore[arg-type]
+    _check_only_the_crashing_samples_are_lost(t)
+    assert t["error"][t["cycloid.d_rrp"] > 6e-6].str.contains("BrokenProcessPool").all()
+
+
+def test_a_crashing_sample_fails_alone_on_ray(monkeypatch: pytest.MonkeyPatch) -> None:
+    # The Ray pool lost the whole chunk and the study stopped with a RunnerError.
+    pytest.importorskip("ray", reason="Ray is not installed (pip install 'rvdyn[ray]')")
+    # Ray's workers import this module (the kernel's function) from the path they inherit.
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [os.path.dirname(os.path.abspath(__file__)),
+                                                                   os.environ.get("PYTHONPATH")])))
+    t = rvdyn.study(SCENE, FunctionKernel(crashing_metric, ("y",)), [Tolerance("cycloid.d_rrp", tol=1e-5)],
+                    runner="ray:2", retries=0, **CRASH_ARGS)  # type: ignore[arg-type]
+    _check_only_the_crashing_samples_are_lost(t)

@@ -440,7 +440,8 @@ def _run_study(args: argparse.Namespace) -> int:
 
     res = run_spec(args.spec, out=args.out, samples=args.samples, plots=not args.no_plots)
     y = res.get("yield")
-    print(f"rvdyn study: {res['samples']} samples, {res['failed']} failed"
+    lost = f" ({res['lost']} lost by the runner, left out of the statistics)" if res.get("lost") else ""
+    print(f"rvdyn study: {res['samples']} samples, {res['failed']} failed{lost}"
           + (f"; yield {y['rate']['value']:.4g} [{y['rate']['low']:.4g}, {y['rate']['high']:.4g}]" if y else ""))
     if res["samples"] and res["failed"] == res["samples"]:
         # Nothing to analyse: a wrong kernel option fails every sample, and a job script

@@ -30,7 +30,7 @@ from .driver import run
 from .kernels import (DYNAMIC_METRICS, KERNELS, LTCA_METRICS, DynamicKernel, FunctionKernel, LtcaKernel, get_kernel,
                       register_kernel)
 from .plots import plot_histogram, plot_sensitivity
-from .runners import RunnerError, ThreadRunner, evaluate, evaluate_batch
+from .runners import RUNNER_FAILED, RunnerError, RunnerFailureWarning, ThreadRunner, evaluate, evaluate_batch
 from .sampling import LatinHypercube, MonteCarlo, design
 from .spec import Correlation, Criterion, Tolerance, expand
 from .stats import Interval, Sensitivity, YieldResult, describe, sobol, src, yield_rate
@@ -40,7 +40,8 @@ __all__ = [
     "run", "read", "Tolerance", "Correlation", "Criterion", "MonteCarlo", "LatinHypercube", "design", "expand",
     "DynamicKernel", "LtcaKernel", "FunctionKernel", "KERNELS", "DYNAMIC_METRICS", "LTCA_METRICS", "register_kernel",
     "get_kernel",
-    "RunnerError", "ThreadRunner", "evaluate", "evaluate_batch", "describe", "yield_rate", "src", "sobol", "Interval",
+    "RunnerError", "RunnerFailureWarning", "RUNNER_FAILED", "ThreadRunner", "evaluate", "evaluate_batch",
+    "describe", "yield_rate", "src", "sobol", "Interval",
     "YieldResult", "Sensitivity", "plot_histogram", "plot_sensitivity",
 ]
 

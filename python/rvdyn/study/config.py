@@ -87,7 +87,26 @@ def _keys(section: str, d: Any, allowed: set[str]) -> dict[str, Any]:
     return d
 
 
+_RUNNER_KINDS = ("threads", "processes", "dask", "ray")
+
+
+def _check_runner(d: dict[str, Any]) -> None:
+    """Refuse a [runner] table that cannot work, before a cluster starts or a sample runs."""
+    kind = d.get("kind", "threads")
+    if kind not in _RUNNER_KINDS:
+        raise ParameterError(f"[runner] kind must be 'threads', 'processes', 'dask' or 'ray', got {kind!r}")
+    workers = d.get("workers")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ParameterError(f"[runner] workers must be a positive integer (the number of worker threads or "
+                             f"processes), got {workers!r}; leave it out for the default")
+    address = d.get("address")
+    if address is not None and (not isinstance(address, str) or not address):
+        raise ParameterError(f"[runner] address must be a string such as \"tcp://scheduler:8786\" or "
+                             f"\"ray://head:10001\", got {address!r}")
+
+
 def _runner(d: dict[str, Any]) -> Any:
+    _check_runner(d)
     kind = d.get("kind", "threads")
     workers = d.get("workers")
     address = d.get("address")
@@ -104,9 +123,7 @@ def _runner(d: dict[str, Any]) -> Any:
         cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1,  # type: ignore[no-untyped-call, unused-ignore]
                                processes=True, dashboard_address=None)
         return Client(cluster)  # type: ignore[no-untyped-call, unused-ignore]
-    if kind == "ray":
-        return str(address) if address else f"ray{suffix}"
-    raise ParameterError(f"[runner] kind must be 'threads', 'processes', 'dask' or 'ray', got {kind!r}")
+    return str(address) if address else f"ray{suffix}"  # kind == "ray"
 
 
 def _dotted(changes: dict[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -138,6 +155,7 @@ def load_spec(path: str | Path) -> dict[str, Any]:
 
 def _load_spec(path: str | Path) -> dict[str, Any]:
     from .sampling import LatinHypercube, MonteCarlo
+    from .spec import check_criteria, expand
 
     p = Path(path)
     spec = _toml(p)
@@ -169,13 +187,23 @@ def _load_spec(path: str | Path) -> dict[str, Any]:
     tols = spec.get("tolerances")
     if not tols or not isinstance(tols, list):
         raise ParameterError("study spec: give at least one [[tolerances]] entry")
+    corrs = spec.get("correlations", [])
+    if not isinstance(corrs, list):
+        raise ParameterError("study spec: correlations must be [[correlations]] tables (paths, rho or matrix)")
+    crits = spec.get("criteria", [])
+    if not isinstance(crits, list):
+        raise ParameterError("study spec: criteria must be [[criteria]] tables (metric, max, min)")
+    # Tolerances, correlations and criteria are checked now, before a cluster starts or a sample runs.
+    expand(scene, tols, corrs)
+    check_criteria(crits, None)
     runner = _keys("runner", spec.get("runner", {}), {"kind", "workers", "address"})
+    _check_runner(runner)
     output = _keys("output", spec.get("output", {}), {"dir", "chunk_size", "batch_size"})
     outdir = Path(output.get("dir", "study-out"))
     if not outdir.is_absolute():
         outdir = base / outdir
     return {"scene": scene, "kernel": kname, "kernel_options": kern, "tolerances": tols,
-            "correlations": spec.get("correlations", []), "criteria": spec.get("criteria", []),
+            "correlations": corrs, "criteria": crits,
             "samples": sampler, "seed": samp.get("seed", 0), "runner_spec": runner, "output": outdir,
             "chunk_size": output.get("chunk_size", 1000), "batch_size": output.get("batch_size", 1)}
 
@@ -185,7 +213,8 @@ def run_spec(path: str | Path, out: str | Path | None = None, samples: int | Non
     """Run the study of a spec file: writes ``results.parquet/`` (the table),
     ``statistics.json`` (summary, yield, sensitivity) and, with ``plots``, a histogram per
     metric and a sensitivity bar chart per metric into the output folder. Returns the
-    statistics."""
+    statistics: ``failed`` counts every row with an error, ``lost`` those the runner lost
+    (left out of the yield and summaries, with a ``RunnerFailureWarning``)."""
     from . import stats
     from .driver import run
     from .sampling import as_sampler
@@ -212,9 +241,12 @@ def run_spec(path: str | Path, out: str | Path | None = None, samples: int | Non
             runner.close()
             if cluster is not None:
                 cluster.close()
+    from .runners import RUNNER_FAILED
+
     summary = stats.describe(table)
     errors = table["error"][table["error"] != ""]
-    result: dict[str, Any] = {"samples": int(len(table)), "failed": int(len(errors)),
+    lost = sum(1 for e in errors if str(e).startswith(RUNNER_FAILED))
+    result: dict[str, Any] = {"samples": int(len(table)), "failed": int(len(errors)), "lost": lost,
                               "first_error": str(next(iter(errors))) if len(errors) else None,
                               "metrics": {m: {k: (v.__dict__ if isinstance(v, stats.Interval) else v)
                                               for k, v in e.items()} for m, e in summary.items()}}

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..scene import Scene
-from .kernels import get_kernel
+from .kernels import get_kernel, metric_units
 from .runners import RunnerError, Task, _Failure, check_picklable, evaluate_batch, resolve_runner
 from .sampling import as_sampler, design
 from .spec import Correlation, Criterion, Tolerance, check_criteria, expand
@@ -87,7 +87,7 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
     k = get_kernel(kernel, **(kernel_options or {}))
     layout = expand(scene, tolerances, correlations)
     metrics = getattr(k, "metrics", None)
-    check_criteria(criteria, metrics)
+    crits = check_criteria(criteria, metrics)
     sampler = as_sampler(samples)
     x = design(layout, sampler, seed)
     n = x.shape[0]
@@ -100,7 +100,16 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
     meta = {"version": 1, "fingerprint": fingerprint.hexdigest(), "samples": n, "seed": seed,
             "sampler": repr(sampler), "kernel": _kernel_id(k), "inputs": layout.columns,
             "metrics": list(metrics) if metrics is not None else None,
-            "tolerances": [repr(t) for t in layout.tolerances], "scene": json.loads(scene.to_json())}
+            "tolerances": [repr(t) for t in layout.tolerances],
+            # Input values are in the SI unit of their scene field (docs/scene.md); the metrics'
+            # units are the kernel's.
+            "input_paths": {v.column: v.path for v in layout.variables},
+            "metric_units": metric_units(k),
+            "correlations": [{"columns": [layout.variables[c].column for c in cols],
+                              "matrix": (chol @ chol.T).round(15).tolist()} for cols, chol in layout.groups],
+            "criteria": [{"metric": c.metric, "min": None if c.min is None else float(c.min),
+                          "max": None if c.max is None else float(c.max)} for c in crits],
+            "scene": json.loads(scene.to_json())}
     task = Task(scene, k, layout, threads_per_worker, os.getpid())
     mapper = resolve_runner(runner, retries=retries, timeout=connect_timeout)
     try:

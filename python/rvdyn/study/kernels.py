@@ -102,6 +102,21 @@ class DynamicKernel:
         }
 
 
+def metric_units(kernel: Any) -> dict[str, str]:
+    """The unit of each metric of ``kernel`` that it states: a ``units`` mapping of the kernel,
+    else the ``[unit]`` that ends each description of the built-in kernels' metrics ("-" for
+    none). Empty for a kernel that does not say."""
+    units = getattr(kernel, "units", None)
+    if isinstance(units, Mapping):
+        return {str(k): str(v) for k, v in units.items()}
+    docs = {DynamicKernel: DYNAMIC_METRICS, LtcaKernel: LTCA_METRICS}.get(type(kernel), {})
+    out: dict[str, str] = {}
+    for name, text in docs.items():
+        if text.endswith("]") and "[" in text:
+            out[name] = text[text.rindex("[") + 1:-1]
+    return out
+
+
 def _ratio(scene: Scene) -> float:
     """Transmission ratio input speed / output speed of the scene."""
     ratio = getattr(scene, "ratio", None)

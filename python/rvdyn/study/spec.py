@@ -47,11 +47,16 @@ _EMPTY_LIST_SHAPES: dict[str, Callable[[Scene], tuple[int, ...]]] = {
 }
 
 
+def _is_number(value: Any) -> bool:
+    """A real number: int or float (numpy's too), not a bool or a string such as "1e-5"."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
 def _finite(name: str, what: str, value: Any) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"tolerance {name!r}: {what} must be a number, got {value!r}") from None
+    if not _is_number(value):
+        raise ParameterError(f"tolerance {name!r}: {what} must be a number [field units], got {value!r}"
+                             + (" (true/false is not a number)" if isinstance(value, (bool, np.bool_)) else ""))
+    v = float(value)
     if not math.isfinite(v):
         raise ParameterError(f"tolerance {name!r}: {what} must be finite, got {v}")
     return v
@@ -131,11 +136,12 @@ class Criterion:
         for what, v in (("max", self.max), ("min", self.min)):
             if v is None:
                 continue
-            try:
-                x = float(v)
-            except (TypeError, ValueError):
-                raise ParameterError(f"criterion on {self.metric!r}: {what} must be a number, got {v!r}") from None
-            if isinstance(v, bool) or not math.isfinite(x):
+            if not _is_number(v):
+                # A string such as "1e5" passed float() here and failed after the whole study
+                # had run, when the values were compared with it.
+                raise ParameterError(f"criterion on {self.metric!r}: {what} must be a number, got {v!r}"
+                                     + (" (write it without quotes)" if isinstance(v, str) else ""))
+            if not math.isfinite(float(v)):
                 raise ParameterError(f"criterion on {self.metric!r}: {what} must be finite, got {v!r}")
         if self.max is not None and self.min is not None and float(self.min) > float(self.max):
             raise ParameterError(
@@ -314,6 +320,9 @@ def _group(layout: Layout, c: Correlation) -> tuple[list[int], np.ndarray]:
     if (c.rho is None) == (c.matrix is None):
         raise ParameterError(f"correlation {paths}: give rho or matrix (one of them)")
     if c.rho is not None:
+        if not _is_number(c.rho):
+            raise ParameterError(f"correlation {paths}: rho must be a number in (-1/(n-1), 1) = "
+                                 f"({-1.0 / max(n - 1, 1):.4g}, 1) for {n} variables, got {c.rho!r}")
         rho = float(c.rho)
         if not (math.isfinite(rho) and -1.0 / max(n - 1, 1) < rho < 1.0):
             raise ParameterError(f"correlation {paths}: rho must lie in (-1/(n-1), 1) = ({-1.0 / max(n - 1, 1):.4g}, 1) "
@@ -321,7 +330,14 @@ def _group(layout: Layout, c: Correlation) -> tuple[list[int], np.ndarray]:
         m = np.full((n, n), rho)
         np.fill_diagonal(m, 1.0)
     else:
-        m = np.asarray(c.matrix, dtype=float)
+        rows = c.matrix.tolist() if isinstance(c.matrix, np.ndarray) else c.matrix
+        if (not isinstance(rows, (list, tuple)) or len(rows) != n
+                or any(not isinstance(r, (list, tuple)) or len(r) != n for r in rows)):
+            raise ParameterError(f"correlation {paths}: matrix must be {n}x{n}, a list of {n} rows of {n} numbers "
+                                 f"(one row and column per variable), got {c.matrix!r}")
+        if not all(_is_number(x) for r in rows for x in r):
+            raise ParameterError(f"correlation {paths}: matrix entries must be numbers, got {c.matrix!r}")
+        m = np.array(rows, dtype=float)
         if m.shape != (n, n):
             raise ParameterError(f"correlation {paths}: matrix must be {n}x{n} (one row per variable), got {m.shape}")
         if not np.all(np.isfinite(m)) or not np.allclose(m, m.T) or not np.allclose(np.diag(m), 1.0):
@@ -356,6 +372,10 @@ def _correlation_from_dict(d: dict[str, Any]) -> Correlation:
     extra = set(d) - {"paths", "rho", "matrix"}
     if extra or "paths" not in d:
         raise ParameterError(f"correlation {d!r}: needs 'paths' and 'rho' or 'matrix' (unknown keys {sorted(extra)})")
+    if not isinstance(d["paths"], (str, list, tuple)) or not all(isinstance(x, str) for x in
+                                                                 ([d["paths"]] if isinstance(d["paths"], str) else d["paths"])):
+        raise ParameterError(f"correlation {d!r}: paths must be a list of toleranced paths (strings), "
+                             f"got {d['paths']!r}")
     return Correlation(paths=tuple(d["paths"]) if not isinstance(d["paths"], str) else (d["paths"],),
                        rho=d.get("rho"), matrix=d.get("matrix"))
 

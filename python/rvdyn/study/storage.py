@@ -5,10 +5,13 @@ the scene got, field units), one float64 column per metric (NaN for a failed sam
 ``error`` (the failure message, "" for a sample that ran).
 
 On disk (``out="study.parquet"``) the table is a folder: ``_meta.json`` (what the study is,
-checked on resume) and ``part-<seq>.parquet`` files, one per chunk, each written to a temporary
-name then renamed, so a crash never leaves a partial part. Pandas and pyarrow read the folder
-as one table (``pandas.read_parquet(path)``); :func:`read` sorts it by sample id, keeping the
-newest row of a sample that was run again.
+checked on resume; inputs with their scene paths, metrics with their units, correlations,
+criteria) and ``part-<seq>.parquet`` files, one per chunk, each written to a temporary name
+then renamed, so a crash never leaves a partial part. Every part has every column (a metric
+first seen in a later chunk is added to the earlier parts, NaN-filled), so pandas and pyarrow,
+which take a folder's columns from one part, read the folder as one table
+(``pandas.read_parquet(path)``); :func:`read` sorts it by sample id, keeping the newest row of
+a sample that was run again.
 """
 
 from __future__ import annotations
@@ -92,6 +95,9 @@ class ParquetStore:
             os.replace(tmp, meta_file)
         self.meta = meta
         self._seq = max((self._seq_of(p) for p in self._parts()), default=-1) + 1
+        self._names: list[str] = []  # the columns of every part, in order
+        for part in self._parts():
+            self._names = _merge_names(self._names, _part_names(part))
 
     @staticmethod
     def _seq_of(p: Path) -> int:
@@ -116,26 +122,63 @@ class ParquetStore:
         return ids
 
     def write(self, cols: dict[str, np.ndarray]) -> None:
+        """Write a chunk as a new part. Every part carries every column (a metric a part's
+        samples did not give is NaN there): pyarrow and pandas take a folder's columns from one
+        part, and dropped the metric columns of a study whose first chunk had failed."""
+        names = _merge_names(self._names, list(cols))
+        grew = names != self._names
+        self._names = names
+        if grew:
+            for part in self._parts():  # a metric seen for the first time: add it to the parts so far
+                if _part_names(part) != names:
+                    self._write(_read_part(part), part.name)
+        self._write(cols, f"part-{self._seq:06d}.parquet")
+        self._seq += 1
+
+    def _write(self, cols: dict[str, np.ndarray], name: str) -> None:
         import pyarrow as pa  # type: ignore[import-untyped, import-not-found, unused-ignore]
         import pyarrow.parquet as pq  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
-        arrays = {k: (pa.array(v.tolist(), type=pa.string()) if k == "error" else pa.array(v)) for k, v in cols.items()}
-        table = pa.table(arrays)
-        final = self.path / f"part-{self._seq:06d}.parquet"
-        tmp = self.path / f".part-{self._seq:06d}.tmp"
-        pq.write_table(table, tmp)
+        n = len(cols["sample"])
+        arrays = {}
+        for k in self._names:
+            v = cols.get(k)
+            if k == "error":
+                arrays[k] = pa.array([""] * n if v is None else [str(e) for e in v], type=pa.string())
+            else:
+                arrays[k] = pa.array(np.full(n, np.nan) if v is None else v)
+        final = self.path / name
+        tmp = self.path / f".{name}.tmp"
+        pq.write_table(pa.table(arrays), tmp)
         os.replace(tmp, final)
-        self._seq += 1
 
     def columns(self) -> dict[str, np.ndarray]:
-        import pyarrow.parquet as pq  # type: ignore[import-untyped, import-not-found, unused-ignore]
+        return _concat([_read_part(p) for p in self._parts()])
 
-        parts = []
-        for p in self._parts():
-            t = pq.read_table(p)
-            parts.append({name: (np.array(t.column(name).to_pylist(), dtype=object) if name == "error"
-                                 else t.column(name).to_numpy()) for name in t.column_names})
-        return _concat(parts)
+
+def _part_names(part: Path) -> list[str]:
+    import pyarrow.parquet as pq  # type: ignore[import-untyped, import-not-found, unused-ignore]
+
+    return list(pq.read_schema(part).names)
+
+
+def _read_part(part: Path) -> dict[str, np.ndarray]:
+    import pyarrow.parquet as pq  # type: ignore[import-untyped, import-not-found, unused-ignore]
+
+    t = pq.read_table(part)
+    return {name: (np.array(t.column(name).to_pylist(), dtype=object) if name == "error"
+                   else t.column(name).to_numpy()) for name in t.column_names}
+
+
+def _merge_names(names: list[str], new: list[str]) -> list[str]:
+    """``names`` with the columns of ``new`` it lacks, inserted before ``error`` (the last column)."""
+    extra = [k for k in new if k not in names]
+    if not extra:
+        return names
+    if "error" in names:
+        i = names.index("error")
+        return names[:i] + [k for k in extra if k != "error"] + names[i:]
+    return names + [k for k in extra if k != "error"] + (["error"] if "error" in extra else [])
 
 
 def _concat(parts: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
