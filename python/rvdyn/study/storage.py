@@ -250,7 +250,13 @@ def open_store(out: str | Path | None, meta: dict[str, Any], resume: bool = True
 
 
 def read(path: str | Path, as_numpy: bool = False) -> Any:
-    """Read a study folder written by :func:`rvdyn.study.run` as one table sorted by sample id."""
+    """Read a study folder written by :func:`rvdyn.study.run` as one table sorted by sample id:
+    a pandas DataFrame (or, with ``as_numpy`` or without pandas, a numpy structured array) with
+    the columns ``sample`` (int), one per input (its scene path; the value in that field's SI
+    unit, docs/scene.md), one per metric (float; units in ``read_meta(path)["metric_units"]``;
+    NaN where the sample failed) and ``error`` (str, ``""`` for a sample that ran). The column
+    roles are in ``DataFrame.attrs["inputs"]``/``["metrics"]`` (``dtype.metadata`` for the
+    array). Raises ParameterError for a folder without ``_meta.json``."""
     p = Path(path)
     if not (p / META).exists():
         raise ParameterError(f"{str(p)!r} is not a study folder (no {META})")
