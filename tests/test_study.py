@@ -351,6 +351,10 @@ def test_every_parquet_part_has_every_column_and_the_meta_describes_the_study(tm
     assert meta["metric_units"] == {"te_pp_forward": "rad", "te_pp_reverse": "rad", "peak_pin_force": "N",
                                     "loaded_pins_min": "-", "torsional_rigidity": "N m/rad", "lost_motion": "rad"}
     assert meta["input_paths"] == {"cycloid.d_rrp": "cycloid.d_rrp", "cycloid.d_rp": "cycloid.d_rp"}
+    assert meta["input_units"] == {"cycloid.d_rrp": "m", "cycloid.d_rp": "m"}
+    from rvdyn.study.driver import field_unit
+    assert [field_unit(p) for p in ("pin_errors.radius[3]", "discs[1].phase", "load.torque", "nope")] == \
+        ["m", "rad", "N m", "?"]
     assert meta["correlations"] == [{"columns": ["cycloid.d_rrp", "cycloid.d_rp"], "matrix": [[1.0, 0.5], [0.5, 1.0]]}]
     assert meta["criteria"] == [{"metric": "peak_pin_force", "min": None, "max": 5e4},
                                 {"metric": "lost_motion", "min": 0.0, "max": None}]

@@ -34,6 +34,7 @@ __all__ = [
     "PAPER_PRINTED_OUTPUT_TORQUE",
     "CompiledScene",
     "default_compliant_joints",
+    "scene_fields",
     "Options",
     "options_from_dict",
     "integrators",
@@ -361,6 +362,11 @@ class CompiledScene:
 
 def default_compliant_joints() -> str:
     """The default compliant joints (assumed bearing stiffness [N/m] and damping [N s/m]) as JSON."""
+
+def scene_fields() -> list[dict[str, str | None]]:
+    """The scene schema (docs/scene.md): one dict per field with its dotted "path" ("[]" for
+    any list index), "when" (the variant it belongs to), "type" (JSON type), "unit" (SI, "-"
+    for none), "default" (JSON text; None = required), "rule" and "doc"."""
 
 @final
 class Options:

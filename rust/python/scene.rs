@@ -213,8 +213,30 @@ fn default_compliant_joints() -> PyResult<String> {
         .map_err(|e| crate::python::parameter_error(format!("cannot write joints: {e}")))
 }
 
+/// The scene schema (docs/scene.md): one dict per field with its dotted `path` (`[]` for any
+/// list index), the variant it belongs to (`when`), JSON `type`, SI `unit` (`-` for none),
+/// `default` as JSON text (None = required), `rule` and `doc`.
+#[pyfunction]
+fn scene_fields(py: Python<'_>) -> PyResult<Vec<Bound<'_, pyo3::types::PyDict>>> {
+    crate::dynamics::scene::schema::FIELDS
+        .iter()
+        .map(|f| {
+            let d = pyo3::types::PyDict::new(py);
+            d.set_item("path", f.path)?;
+            d.set_item("when", f.when)?;
+            d.set_item("type", f.ty)?;
+            d.set_item("unit", f.unit)?;
+            d.set_item("default", f.default)?;
+            d.set_item("rule", f.rule)?;
+            d.set_item("doc", f.doc)?;
+            Ok(d)
+        })
+        .collect()
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<CompiledScene>()?;
     m.add_function(wrap_pyfunction!(default_compliant_joints, m)?)?;
+    m.add_function(wrap_pyfunction!(scene_fields, m)?)?;
     Ok(())
 }

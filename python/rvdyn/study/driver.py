@@ -7,6 +7,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -14,6 +15,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from .. import _core
 from ..errors import ParameterError
 from ..scene import Scene
 from .kernels import get_kernel, metric_units
@@ -24,6 +26,17 @@ from .storage import _columns_of_records, open_store, to_table
 
 __all__ = ["run"]
 
+
+def field_unit(path: str) -> str:
+    """The SI unit of the scene field at the dotted ``path`` (docs/scene.md; a list index
+    ``[3]`` reads as the list's items), ``"-"`` for none, ``"?"`` for a path the schema does not
+    list."""
+    units = {f["path"]: f["unit"] for f in _core.scene_fields()}
+    p = re.sub(r"\[\d+\]", "[]", path)
+    for candidate in (p, p.removesuffix("[]"), re.sub(r"\[\]$", "", p)):
+        if candidate in units:
+            return str(units[candidate])
+    return "?"
 
 def _kernel_id(kernel: Any) -> str:
     fn = getattr(kernel, "fn", None)
@@ -104,6 +117,7 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
             # Input values are in the SI unit of their scene field (docs/scene.md); the metrics'
             # units are the kernel's.
             "input_paths": {v.column: v.path for v in layout.variables},
+            "input_units": {v.column: field_unit(v.path) for v in layout.variables},
             "metric_units": metric_units(k),
             "correlations": [{"columns": [layout.variables[c].column for c in cols],
                               "matrix": (chol @ chol.T).round(15).tolist()} for cols, chol in layout.groups],
