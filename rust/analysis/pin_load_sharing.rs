@@ -357,7 +357,7 @@ pub fn physics_summary(scene: &crate::dynamics::Scene) -> Result<PhysicsSummary>
     let (mesh_force, mesh_stiffness) = match &scene.stage1 {
         Some(s) => {
             let f = t_out / ratio / (f64::from(s.planets) * s.sun_base_radius());
-            let k = match scene.contact.mesh.mesh_law(s)? {
+            let k = match scene.stage_mesh_law(s)? {
                 MeshLaw::Iso(m) => m.wave.mean(),
                 MeshLaw::Impact(l) => {
                     let x = (f / l.stiffness).powf(1.0 / l.exponent);

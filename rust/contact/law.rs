@@ -399,9 +399,12 @@ pub struct IsoMesh {
 impl IsoMesh {
     /// The ISO 6336-1 method B mesh of a solid, unshifted spur pair (standard rack) with
     /// `z_sun`, `z_planet` teeth, module \[m\], pressure angle \[rad\], face width \[m\], the stiffness
-    /// ramps `ramp` (fraction of a base pitch) and the damping.
+    /// ramps `ramp` (fraction of a base pitch), the damping and the nominal line load
+    /// `F_t K_A / b` \[N/m\] of the load factor (`None`: 100 N/mm or more, factor 1).
     ///
-    /// Errors as [`IsoGearPair::validate`], [`MeshStiffnessWave::new`], [`ContactDamping::new`].
+    /// Errors as [`IsoGearPair::validate`], [`MeshStiffnessWave::new`], [`ContactDamping::new`],
+    /// `Parameter` for a line load that is not finite and > 0.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         z_sun: u32,
         z_planet: u32,
@@ -410,10 +413,20 @@ impl IsoMesh {
         face_width: f64,
         ramp: f64,
         damping: &DampingSpec,
+        line_load: Option<f64>,
     ) -> Result<Self> {
         let pair = IsoGearPair::spur(z_sun, z_planet, module, pressure_angle, face_width);
         let eps = spur_contact_ratio(z_sun, z_planet, module, pressure_angle)?;
-        let single = pair.to_newton_per_metre(pair.single_stiffness(100.0)?);
+        // ISO 6336-1 takes the line load in N/mm.
+        if let Some(w) = line_load
+            && !(w.is_finite() && w > 0.0)
+        {
+            return Err(RvdynError::Parameter(format!(
+                "line_load must be a finite line load > 0 N/m (e.g. 1e5 N/m = 100 N/mm), got {w}"
+            )));
+        }
+        let per_mm = line_load.map_or(100.0, |w| 1e-3 * w);
+        let single = pair.to_newton_per_metre(pair.single_stiffness(per_mm)?);
         let wave = MeshStiffnessWave::new(single, eps, base_pitch(module, pressure_angle), ramp)?;
         Ok(Self {
             wave,
@@ -541,20 +554,30 @@ mod tests {
 
     #[test]
     fn iso_mesh_law_of_the_paper_stage() {
-        let m = IsoMesh::new(
-            18,
-            42,
-            3e-3,
-            20f64.to_radians(),
-            0.030,
-            0.02,
-            &DampingSpec::DampingRatio {
-                ratio: 0.05,
-                frequency: 1000.0,
-            },
-        )
-        .unwrap();
+        let mesh = |line_load: Option<f64>| {
+            IsoMesh::new(
+                18,
+                42,
+                3e-3,
+                20f64.to_radians(),
+                0.030,
+                0.02,
+                &DampingSpec::DampingRatio {
+                    ratio: 0.05,
+                    frequency: 1000.0,
+                },
+                line_load,
+            )
+        };
+        let m = mesh(None).unwrap();
         assert!((m.wave.mean() / 5.546e8 - 1.0).abs() < 1e-3);
+        // ISO 6336-1: at or above 100 N/mm the full c'; below, c' (w / 100 N/mm)^(1/4).
+        assert_eq!(mesh(Some(2e5)).unwrap().wave.mean(), m.wave.mean());
+        let light = mesh(Some(29e3)).unwrap().wave.mean();
+        assert!((light / m.wave.mean() - 0.29f64.powf(0.25)).abs() < 1e-12);
+        for bad in [0.0, -1.0, f64::NAN] {
+            assert!(matches!(mesh(Some(bad)), Err(RvdynError::Parameter(_))));
+        }
         let law = MeshLaw::Iso(m);
         assert_eq!(law.mean_stiffness(0.0), m.wave.mean());
         let (f, _) = m.evaluate(1e-5, 0.0, 0.004, true);

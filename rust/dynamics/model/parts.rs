@@ -169,7 +169,7 @@ impl Parts {
                     sun_base_radius: s.sun_base_radius(),
                     planet_base_radius: s.planet_base_radius(),
                     backlash: s.backlash,
-                    law: scene.contact.mesh.mesh_law(s)?,
+                    law: scene.stage_mesh_law(s)?,
                     count,
                     phases,
                     base_pitch: pb,

@@ -437,6 +437,11 @@ pub enum ContactLawSpec {
         ramp: f64,
         /// Damping of the meshes.
         damping: DampingSpec,
+        /// Nominal line load `F_t K_A / b` \[N/m\] of one sun/planet mesh for the ISO 6336-1
+        /// load factor: below 1e5 N/m (100 N/mm) `c'` is scaled by `(w / 1e5)^(1/4)`. `None`
+        /// (default): from the scene's load ([`Scene::nominal_mesh_line_load`]).
+        #[serde(default)]
+        line_load: Option<f64>,
     },
 }
 
@@ -512,12 +517,21 @@ impl ContactLawSpec {
         }
     }
 
-    /// The sun/planet mesh law for the stage `stage`.
+    /// The sun/planet mesh law for the stage `stage`; `nominal_line_load` \[N/m\] is the ISO
+    /// law's line load when the spec gives none (`None`: the full-load `c'`).
     ///
     /// Errors (`Scene`) for `line` (a pin law) and invalid parameters.
-    pub fn mesh_law(&self, stage: &InvoluteStage) -> Result<MeshLaw> {
+    pub fn mesh_law(
+        &self,
+        stage: &InvoluteStage,
+        nominal_line_load: Option<f64>,
+    ) -> Result<MeshLaw> {
         match *self {
-            ContactLawSpec::Iso6336 { ramp, damping } => Ok(MeshLaw::Iso(
+            ContactLawSpec::Iso6336 {
+                ramp,
+                damping,
+                line_load,
+            } => Ok(MeshLaw::Iso(
                 IsoMesh::new(
                     stage.z_sun,
                     stage.z_planet,
@@ -526,6 +540,7 @@ impl ContactLawSpec {
                     stage.face_width,
                     ramp,
                     &damping,
+                    line_load.or(nominal_line_load),
                 )
                 .map_err(|e| RvdynError::Scene(format!("contact.mesh: {e}")))?,
             )),
@@ -917,6 +932,34 @@ impl Scene {
             p.d_delta = d.d_delta.unwrap_or(p.d_delta);
         }
         p
+    }
+
+    /// Nominal line load `F_t K_A / b` \[N/m\] of one sun/planet mesh for the ISO 6336-1 load
+    /// factor: the largest output torque magnitude of the load law over the ratio is the sun's
+    /// torque, shared by the planets at the sun's reference radius `m z_sun / 2`
+    /// (`F_t = 2 T_sun / (d_sun planets)`, ISO 6336-1 clause 6), with `K_A = 1` (the dynamics
+    /// are modelled, not factored) and `b` the face width. `None` without a first stage or
+    /// without load (idle: the load factor is then not applied).
+    pub fn nominal_mesh_line_load(&self) -> Option<f64> {
+        let s = self.stage1.as_ref()?;
+        let t_out = match &self.load {
+            Load::Idle => 0.0,
+            Load::Constant { torque } => torque.abs(),
+            Load::Step { before, after, .. } => before.abs().max(after.abs()),
+            Load::Table { points } => points.iter().fold(0.0f64, |m, p| m.max(p[1].abs())),
+        };
+        let t_sun = t_out / self.ratio().abs();
+        let f_t = t_sun / (0.5 * s.module * f64::from(s.z_sun) * f64::from(s.planets));
+        let w = f_t / s.face_width;
+        (w.is_finite() && w > 0.0).then_some(w)
+    }
+
+    /// The sun/planet mesh law of this scene's first stage `stage`, with the ISO law's line
+    /// load from [`Scene::nominal_mesh_line_load`] unless the spec sets it.
+    pub fn stage_mesh_law(&self, stage: &InvoluteStage) -> Result<MeshLaw> {
+        self.contact
+            .mesh
+            .mesh_law(stage, self.nominal_mesh_line_load())
     }
 
     /// Transmission ratio input speed / output speed of this scene (57 for the paper; `-zc`

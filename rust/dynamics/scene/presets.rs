@@ -75,6 +75,7 @@ impl Scene {
                 damping,
             },
             mesh: ContactLawSpec::Iso6336 {
+                line_load: None,
                 ramp: default_mesh_ramp(),
                 damping,
             },

@@ -766,6 +766,15 @@ pub static FIELDS: &[Field] = &[
         "damping of the meshes",
     ),
     f(
+        "contact.*.line_load",
+        "kind = iso6336",
+        "number or null",
+        "N/m",
+        NULL,
+        "> 0",
+        "nominal line load F_t K_A / b of one mesh for the ISO 6336-1 load factor (below 1e5 N/m = 100 N/mm, c' times (w / 1e5 N/m)^(1/4)); null = from the scene's load: the largest output torque magnitude over the ratio, shared by the planets at the sun's reference radius, K_A = 1 (idle: factor 1)",
+    ),
+    f(
         "contact.*.damping.kind",
         "",
         "string",

@@ -260,7 +260,7 @@ impl Scene {
             }
         }
         if let Some(s) = &self.stage1 {
-            self.contact.mesh.mesh_law(s)?;
+            self.stage_mesh_law(s)?;
         }
         match self.drive {
             Drive::Speed {
