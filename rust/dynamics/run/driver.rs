@@ -353,7 +353,13 @@ pub fn fixed_step_warnings(scene: &Scene, opt: &SimOptions) -> Result<Vec<String
     if opt.method.0.adaptive {
         return Ok(Vec::new());
     }
-    let dt = opt.settings().dt;
+    let s = opt.settings();
+    // The step the fixed clock takes: t_end in whole steps of at most dt.
+    let dt = if s.t_end.is_finite() && s.t_end > 0.0 {
+        crate::solve::integrator::FixedClock::new(s.t_end, s.dt).h
+    } else {
+        s.dt
+    };
     let name = opt.method.name();
     let mut out = Vec::new();
     if let crate::dynamics::scene::Drive::Speed { speed, .. } = scene.drive {
@@ -362,12 +368,12 @@ pub fn fixed_step_warnings(scene: &Scene, opt: &SimOptions) -> Result<Vec<String
             2.0 * std::f64::consts::PI * scene.ratio().abs() / (zp * (zp - 1.0) * speed.abs());
         if period.is_finite() && dt * STEPS_PER_MESH_PERIOD > period {
             out.push(format!(
-                "{name} with dt = {dt:.3e} s takes {:.1} steps per pin-mesh period ({:.3e} s at \
+                "{name} with dt = {dt:.4e} s takes {:.2} steps per pin-mesh period ({:.3e} s at \
                  the input speed): the pin forces can be off by more than 0.1 % of their peak; \
                  use dt <= {:.1e} s or integrator=\"generalized-alpha-adaptive\"",
                 period / dt,
                 period,
-                period / STEPS_PER_MESH_PERIOD
+                round_down_2(period / STEPS_PER_MESH_PERIOD)
             ));
         }
         if let (ContactLawSpec::Iso6336 { ramp, .. }, Some(stage)) =
@@ -382,12 +388,19 @@ pub fn fixed_step_warnings(scene: &Scene, opt: &SimOptions) -> Result<Vec<String
                      off by more than 0.1 % of their peak; use dt <= {:.1e} s or \
                      integrator=\"dopri5\"",
                     ramp_time / dt,
-                    ramp_time / STEPS_PER_MESH_RAMP
+                    round_down_2(ramp_time / STEPS_PER_MESH_RAMP)
                 ));
             }
         }
     }
     Ok(out)
+}
+
+/// `x` > 0 rounded down to two significant digits (a step advised in a message must pass the
+/// check that printed it: 5.58e-4 printed as 5.6e-4 did not).
+fn round_down_2(x: f64) -> f64 {
+    let p = 10f64.powi(x.log10().floor() as i32 - 1);
+    (x / p).floor() * p
 }
 
 /// Integrate a built model with the integrator named in the options.
@@ -673,6 +686,31 @@ mod tests {
                 "{saved} saved, {at_ends} samples at step ends, {split} splits"
             );
         }
+    }
+
+    /// The step a warning advises passes the check (5.58e-4 s was advised as 5.6e-4 s, which
+    /// the check rejects), and the check measures the step the clock takes.
+    #[test]
+    fn the_advised_step_passes_the_check() {
+        let scene = Scene::paper("rated").unwrap();
+        let warned = |dt: f64, t_end: f64| {
+            let mut opt = SimOptions::new(t_end, Method::parse("generalized-alpha").unwrap());
+            opt.dt = Some(dt);
+            fixed_step_warnings(&scene, &opt).unwrap()
+        };
+        let w = warned(5.6e-4, 1.0);
+        assert_eq!(w.len(), 1, "{w:?}");
+        let advised: f64 = w[0]
+            .split("use dt <= ")
+            .nth(1)
+            .and_then(|r| r.split(' ').next())
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(advised < 5.6e-4);
+        assert!(warned(advised, 1.0).is_empty());
+        // 0.02 s in steps of at most 5.6e-4 s: 36 steps of 5.556e-4 s, which pass.
+        assert!(warned(5.6e-4, 0.02).is_empty());
     }
 
     /// The ISO mesh's stiffness ramp: the physical preset (ramp 48.9 us at its input speed)
