@@ -132,8 +132,12 @@ def test_every_result_method_works_on_every_valid_scene(variant: str, steady_run
     # shaft's torsional transient moves the carrier by 2e-4 here).
     assert r.mean_output_speed() == pytest.approx(speed / ratio, rel=1e-3)
     if VARIANTS[variant]["joints.kind"] == "compliant" and VARIANTS[variant]["joints.eccentric_bearing.rollers"]:
-        life = r.bearing_life()
-        assert all(np.isfinite(v["l10_hours"]) for v in life.values())
+        with warnings.catch_warnings():
+            # The physical preset's assumed bearings are past their ISO 76 static rating at the
+            # rated load (docs/model.md, "Roller bearings"): said, and tested in test_physical.py.
+            warnings.filterwarnings("ignore", message=".*ISO 76 static rating", category=RuntimeWarning)
+            life = r.bearing_life()
+        assert all(np.isfinite(v["l10_hours"]) and v["static_safety"] > 0 for v in life.values())
     else:
         with pytest.raises(rvdyn.ParameterError, match="rollers"):
             r.bearing_life()

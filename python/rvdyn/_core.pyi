@@ -344,8 +344,9 @@ class CompiledScene:
         """The physical preset; load is "idle", "paper" or "rated"."""
     def physics_summary(self) -> str:
         """The contact physics at the rated operating point, as JSON text."""
-    def bearing_ratings(self) -> tuple[float | None, float | None]:
-        """ISO 281 load ratings [N] of the eccentric and crank roller bearings (None if linear)."""
+    def bearing_ratings(self, kind: str = "dynamic") -> tuple[float | None, float | None]:
+        """ISO 281 dynamic load ratings [N] (kind="static": ISO 76 static load ratings) of the
+        eccentric and crank roller bearings (None if linear)."""
     def to_json(self, indent: bool = True) -> str:
         """The scene as JSON text."""
     def to_toml(self) -> str:

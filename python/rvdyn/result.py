@@ -278,7 +278,9 @@ class Result:
 
     def bearing_life(self, t_start: float | None = None) -> dict[str, dict[str, float]]:
         """Peak and equivalent radial load [N], ISO 281 rating [N] and basic rating life
-        ``L10`` [million revolutions and hours] of the most loaded eccentric and crank bearing,
+        ``L10`` [million revolutions and hours], ISO 76 static rating ``C0r`` [N] and static safety
+        ``s0 = C0r / peak load`` (a ``RuntimeWarning`` below 1: the raceways yield, and the elastic
+        roller law no longer holds) of the most loaded eccentric and crank bearing,
         from ``t_start`` [s] to the end (default: :meth:`steady_window`, whole crank revolutions
         relative to the carrier, over which every eccentric bearing sees its whole load cycle).
         The equivalent load weights ``|F|^(10/3)`` by the bearing's revolutions (relative
@@ -288,7 +290,9 @@ class Result:
         one of fewer than two samples a ``ParameterError``. Needs the ``"bearings"`` and ``"motion"`` channels and a
         scene whose bearings are built from rollers (``rollers``): ``ParameterError`` if none is;
         a bearing family without rollers is left out."""
-        c_ecc, c_crank = _core.CompiledScene.from_json(json.dumps(self.scene)).bearing_ratings()
+        compiled = _core.CompiledScene.from_json(json.dumps(self.scene))
+        c_ecc, c_crank = compiled.bearing_ratings()
+        s_ecc, s_crank = compiled.bearing_ratings("static")
         if c_ecc is None and c_crank is None:
             raise ParameterError(
                 "no bearing of this scene is built from rollers, so there is no ISO 281 rating: "
@@ -318,12 +322,12 @@ class Result:
         duration = float(t[-1] - t[0])
         out: dict[str, dict[str, float]] = {}
         crank = self.crank_angle[i0:]
-        for name, rating, forces, rel in (
-            ("eccentric", c_ecc, self.eccentric_bearing_force[i0:],
+        for name, rating, static, forces, rel in (
+            ("eccentric", c_ecc, s_ecc, self.eccentric_bearing_force[i0:],
              crank[:, :, None] - self.disc_angle[i0:][:, None, :]),
-            ("crank", c_crank, self.crank_bearing_force[i0:], crank - self.carrier_angle[i0:][:, None]),
+            ("crank", c_crank, s_crank, self.crank_bearing_force[i0:], crank - self.carrier_angle[i0:][:, None]),
         ):
-            if rating is None:
+            if rating is None or static is None:
                 continue
             mag = np.linalg.norm(forces, axis=-1)
             rev = np.abs(np.diff(rel, axis=0)) / (2 * np.pi)
@@ -334,7 +338,16 @@ class Result:
             p = float(p_eq[worst])
             l10 = (rating / p) ** (10 / 3) if p > 0 else math.inf
             rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
-            out[name] = {"peak_load": float(mag.max()), "equivalent_load": p, "rating": float(rating),
+            peak = float(mag.max())
+            s0 = static / peak if peak > 0 else math.inf
+            if s0 < 1.0:
+                warnings.warn(
+                    f"bearing_life: the {name} bearings' peak load {peak / 1e3:.1f} kN exceeds their ISO 76 "
+                    f"static rating C0r = {static / 1e3:.1f} kN (static safety s0 = {s0:.2f} < 1): the raceways "
+                    "yield there and the elastic roller law, the forces and the life do not hold; use larger "
+                    "bearings (joints.*.rollers) or a lower load", RuntimeWarning, stacklevel=2)
+            out[name] = {"peak_load": peak, "equivalent_load": p, "rating": float(rating),
+                         "static_rating": float(static), "static_safety": s0,
                          "l10_million_revolutions": l10,
                          "l10_hours": l10 * 1e6 / (60.0 * rpm) if rpm > 0 else math.inf}
         return out

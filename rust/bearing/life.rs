@@ -24,6 +24,13 @@
 //! `P = (sum P_k^(10/3) N_k / sum N_k)^(3/10)` (ISO 281, variable load; Harris & Kotzalas,
 //! *Rolling Bearing Analysis*, 5th ed. 2007, vol. 2, ch. on fatigue life).
 //!
+//! Basic static radial load rating of a radial roller bearing (ISO 76:2006, *Rolling bearings -
+//! Static load ratings*): `C0r = 44 (1 - D_we cos alpha / D_pw) i Z L_we D_we cos alpha` [N,
+//! with lengths in mm], the load at which the most loaded roller's contact reaches 4000 MPa and a
+//! permanent deformation of about 1e-4 of the roller diameter. The static safety factor
+//! `s0 = C0r / P0` (`P0` the peak radial load) should be at least 1 (ISO 76 gives 1-3 by
+//! application); below it the raceways yield and an elastic roller law no longer holds.
+//!
 //! Friction torque (A. Palmgren, *Ball and Roller Bearing Engineering*, 3rd ed., Burbank 1959;
 //! as given by Harris & Kotzalas 2007, vol. 1, ch. on friction): `M = M0 + M1` [N mm] with the
 //! load-independent (viscous) part `M0 = 1e-7 f0 (nu n)^(2/3) d_m^3` for `nu n >= 2000` and
@@ -93,6 +100,19 @@ impl RollerBearingGeometry {
     /// `gamma = D_we cos alpha / D_pw` [-].
     pub fn gamma(&self) -> f64 {
         self.roller_diameter * self.contact_angle.cos() / self.pitch_diameter
+    }
+
+    /// Basic static radial load rating `C0r` \[N\] (ISO 76; module documentation).
+    pub fn static_load_rating(&self) -> Result<f64> {
+        self.validate()?;
+        let c = self.contact_angle.cos();
+        Ok(44.0
+            * (1.0 - self.gamma())
+            * f64::from(self.rows)
+            * f64::from(self.rollers)
+            * (self.roller_length * 1e3)
+            * (self.roller_diameter * 1e3)
+            * c)
     }
 
     /// Basic dynamic radial load rating `C_r` \[N\] (ISO 281 with `f_c` from the

@@ -89,12 +89,24 @@ impl CompiledScene {
         Ok(Self::new(Scene::physical(load)?)?)
     }
 
-    /// ISO 281 basic dynamic load ratings [N] of the eccentric and the crank bearings that are
-    /// built from rollers (`None` for a linear bearing, rigid crank bearings or ideal joints).
-    fn bearing_ratings(&self) -> PyResult<(Option<f64>, Option<f64>)> {
+    /// ISO 281 basic dynamic load ratings [N] (`kind="static"`: ISO 76 basic static load
+    /// ratings) of the eccentric and the crank bearings that are built from rollers (`None` for
+    /// a linear bearing, rigid crank bearings or ideal joints).
+    #[pyo3(signature = (kind = "dynamic"))]
+    fn bearing_ratings(&self, kind: &str) -> PyResult<(Option<f64>, Option<f64>)> {
         use crate::dynamics::scene::Joints;
+        let static_ = match kind {
+            "dynamic" => false,
+            "static" => true,
+            other => {
+                return Err(crate::python::parameter_error(format!(
+                    "kind must be \"dynamic\" (ISO 281) or \"static\" (ISO 76), got {other:?}"
+                )));
+            }
+        };
         let rating = |b: Option<&crate::dynamics::scene::Bearing>| -> PyResult<Option<f64>> {
             match b.and_then(|b| b.rollers) {
+                Some(r) if static_ => Ok(Some(r.static_load_rating()?)),
                 Some(r) => Ok(Some(r.load_rating()?)),
                 None => Ok(None),
             }

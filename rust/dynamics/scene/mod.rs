@@ -325,6 +325,15 @@ impl Rollers {
 
     /// ISO 281 basic dynamic load rating \[N\] (one row, `b_m = 1.1`).
     pub fn load_rating(&self) -> Result<f64> {
+        self.geometry().dynamic_load_rating()
+    }
+
+    /// ISO 76 basic static load rating \[N\] (one row).
+    pub fn static_load_rating(&self) -> Result<f64> {
+        self.geometry().static_load_rating()
+    }
+
+    fn geometry(&self) -> crate::bearing::RollerBearingGeometry {
         crate::bearing::RollerBearingGeometry {
             rollers: self.count,
             rows: 1,
@@ -334,7 +343,6 @@ impl Rollers {
             contact_angle: 0.0,
             rating_factor: crate::bearing::life::BM_ROLLER,
         }
-        .dynamic_load_rating()
     }
 
     /// Check the fields, naming `at` (e.g. `"joints.eccentric_bearing"`) in the message.
