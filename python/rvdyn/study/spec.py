@@ -11,6 +11,8 @@ the symmetric band ``[-t, +t]``).
 * ``dist="normal"``: mean = band centre, standard deviation sigma = (upper - lower) / 6, i.e.
   the band is +-3 sigma (band = 6 sigma, process capability Cp = 1; about 0.27 % of the parts
   fall outside the band, the normal is not truncated).
+* ``dist="truncnorm"``: the same normal truncated to the band (``scipy.stats.truncnorm`` at
+  +-3 sigma): parts outside the band are rejected by inspection, so no sample leaves it.
 * ``dist="uniform"``: uniform on ``[lower, upper]``.
 
 A list field (one value per pin, ...) is toleranced element by element: each element is an
@@ -33,7 +35,7 @@ __all__ = ["Tolerance", "Correlation", "Criterion", "Variable", "DISTRIBUTIONS",
            "apply_values", "nominal_scene"]
 
 #: Distributions a :class:`Tolerance` accepts.
-DISTRIBUTIONS = ("normal", "uniform")
+DISTRIBUTIONS = ("normal", "truncnorm", "uniform")
 
 # List fields that are empty in a scene until set, with the shape they take (as scene paths or
 # numbers): an empty list means "no errors", i.e. zeros of this shape.
@@ -67,7 +69,8 @@ class Tolerance:
     """Tolerance of one scene field (SI units of that field).
 
     path: dotted scene path. tol: symmetric band half-width (deviation in [-tol, +tol]), or
-    lower/upper: the deviation band. dist: ``"normal"`` (band = 6 sigma) or ``"uniform"``.
+    lower/upper: the deviation band. dist: ``"normal"`` (band = 6 sigma), ``"truncnorm"`` (the
+    same normal truncated to the band: inspected parts) or ``"uniform"``.
     shape: shape of a list field that is empty in the scene (inferred for the known ones, e.g.
     ``pin_errors.radius`` -> (pins,)). nominal: value the deviation is added to, for fields
     that are null in the scene (``discs.<k>.d_rp`` etc. default to ``cycloid.<name>``).
@@ -186,6 +189,8 @@ class Variable:
 
         if self.dist == "uniform":
             dev = self.lower + (self.upper - self.lower) * u
+        elif self.dist == "truncnorm" and self.upper > self.lower:
+            dev = np.asarray(self.scipy_dist().ppf(u), dtype=float) - self.nominal
         else:
             dev = 0.5 * (self.lower + self.upper) + (self.upper - self.lower) / 6.0 * ndtri(u)
         return self.nominal + dev
@@ -196,6 +201,9 @@ class Variable:
 
         if self.dist == "uniform":
             return stats.uniform(loc=self.nominal + self.lower, scale=self.upper - self.lower)
+        if self.dist == "truncnorm":
+            return stats.truncnorm(-3.0, 3.0, loc=self.nominal + 0.5 * (self.lower + self.upper),
+                                   scale=(self.upper - self.lower) / 6.0)
         return stats.norm(loc=self.nominal + 0.5 * (self.lower + self.upper), scale=(self.upper - self.lower) / 6.0)
 
 
