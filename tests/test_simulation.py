@@ -395,3 +395,11 @@ def test_rk4_runs_a_reducer_that_exchanges_no_energy(dt: float) -> None:
     r = simulate(s, 0.005, "rk4", dt=dt)
     assert r.ok
     assert r.carrier_speed[-1] == pytest.approx(145.351 / 57, rel=1e-3)
+
+
+@pytest.mark.parametrize("t_end", [1e-12, 1e-9])
+def test_a_tiny_run_samples_its_start_and_its_end(t_end: float) -> None:
+    # At t_end = 1e-12 s both samples were taken at t = 0 (an absolute 1e-12 s round-off
+    # allowance of the sample times).
+    r = simulate(Scene.paper("rated"), t_end)
+    assert list(r.t) == [0.0, t_end]

@@ -447,7 +447,10 @@ pub fn run_with<M: ReducerModel>(
     } else {
         Vec::new()
     };
-    while next_sample < n_samples && next_sample as f64 * interval <= st.t + 1e-12 {
+    // Round-off allowance of a sample time against the clock: 1e-12 s, but far below the
+    // interval itself (at t_end = 1e-12 s the second sample was taken at t = 0).
+    let slack = 1e-12f64.min(1e-6 * interval);
+    while next_sample < n_samples && next_sample as f64 * interval <= st.t + slack {
         record(&mut rec, &st)?;
         next_sample += 1;
     }
@@ -472,9 +475,9 @@ pub fn run_with<M: ReducerModel>(
             // else from an evaluation of their own.
             let ts = next_sample as f64 * interval;
             let only_at_end = next_sample < n_samples
-                && (ts - st.t).abs() <= 1e-12
+                && (ts - st.t).abs() <= slack
                 && (next_sample + 1 == n_samples
-                    || (next_sample + 1) as f64 * interval > st.t + 1e-12);
+                    || (next_sample + 1) as f64 * interval > st.t + slack);
             let complete = |st: &mut State, power: [f64; 3]| {
                 st.power = power;
                 for (w, (p0, p1)) in st.work.iter_mut().zip(prev.power.iter().zip(power)) {
@@ -497,7 +500,7 @@ pub fn run_with<M: ReducerModel>(
         }
         while next_sample < n_samples {
             let ts = next_sample as f64 * interval;
-            if ts > st.t + 1e-12 {
+            if ts > st.t + slack {
                 break;
             }
             if at_step_end(&prev, &st, ts) {
