@@ -166,3 +166,10 @@ def test_bearing_static_rating_and_safety() -> None:
         life = light.bearing_life(t_start=0.01)
     assert not [w for w in caught if "static rating" in str(w.message)]
     assert min(v["static_safety"] for v in life.values()) > 1.0
+
+
+def test_bearing_ratings_kind_is_checked() -> None:
+    c = Scene.physical("rated")._compiled
+    assert c.bearing_ratings() == c.bearing_ratings("dynamic")
+    with pytest.raises(rvdyn.ParameterError, match="dynamic.*static"):
+        c.bearing_ratings("fatigue")

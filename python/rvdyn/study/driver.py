@@ -27,15 +27,20 @@ from .storage import _columns_of_records, open_store, to_table
 __all__ = ["run"]
 
 
+@functools.lru_cache(maxsize=1)
+def _field_units() -> dict[str, str]:
+    return {str(f["path"]): str(f["unit"]) for f in _core.scene_fields()}
+
+
 def field_unit(path: str) -> str:
     """The SI unit of the scene field at the dotted ``path`` (docs/scene.md; a list index
     ``[3]`` reads as the list's items), ``"-"`` for none, ``"?"`` for a path the schema does not
     list."""
-    units = {f["path"]: f["unit"] for f in _core.scene_fields()}
+    units = _field_units()
     p = re.sub(r"\[\d+\]", "[]", path)
     for candidate in (p, p.removesuffix("[]"), re.sub(r"\[\]$", "", p)):
         if candidate in units:
-            return str(units[candidate])
+            return units[candidate]
     return "?"
 
 def _kernel_id(kernel: Any) -> str:
