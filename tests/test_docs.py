@@ -218,3 +218,25 @@ def test_default_scene_approaches_at_rated_load() -> None:
     assert f_max == pytest.approx(35.5e3, rel=0.01)
     assert float(res.pin_penetration[i0:].max()) == pytest.approx((f_max / k) ** (1 / 1.5), rel=0.01)
     assert float(res.pin_penetration[i0:].max()) == pytest.approx(199e-6, rel=0.01)
+
+
+def test_result_tuple_fields_document_their_units() -> None:
+    # help(rvdyn.GapResult.gap) shows the field's own description with its unit, not the named
+    # tuple's "Alias for field number 0".
+    for cls in (rvdyn.GapResult, rvdyn.LineContact, rvdyn.OperatingPoint):
+        for name in cls._fields:
+            doc = getattr(cls, name).__doc__ or ""
+            assert "Alias for field" not in doc, (cls.__name__, name, doc)
+            # A unit, or "Unit ..." for the normal vector (dimensionless).
+            assert "[" in doc or "Unit outward normal" in doc, (cls.__name__, name, doc)
+
+
+def test_every_analysis_is_callable_under_its_name_in_rvdyn_analysis() -> None:
+    # rvdyn.analysis.modes(scene) used to be the submodule (TypeError: 'module' object is not
+    # callable) while rvdyn.analysis.ltca was the function.
+    import rvdyn.analysis as an
+
+    for name in ("ltca", "modes", "modes_at", "modes_over_mesh", "campbell", "order_spectrum",
+                 "excitation_orders"):
+        assert callable(getattr(an, name)) and getattr(an, name) is getattr(rvdyn, name), name
+        assert name in an.__all__

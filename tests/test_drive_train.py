@@ -136,5 +136,5 @@ def test_modal_analysis_of_a_scene_with_shafts_models_them(joints: str) -> None:
 
     for shaft, name in (({"inertias.load_inertia": 5.0, "shafts.output": {"stiffness": 1e6}}, "load angle"),
                         ({"inertias.motor_inertia": 0.01, "shafts.input": {"stiffness": 1e4}}, "sun angle")):
-        m = modes.modes(_with(RATED.replace(**shaft), joints))
+        m = modes(_with(RATED.replace(**shaft), joints))
         assert m.dof_names[-1] == name and m.part_names[-1] == "shafts"

@@ -173,3 +173,37 @@ def test_bearing_ratings_kind_is_checked() -> None:
     assert c.bearing_ratings() == c.bearing_ratings("dynamic")
     with pytest.raises(rvdyn.ParameterError, match="dynamic.*static"):
         c.bearing_ratings("fatigue")
+
+
+def test_planet_mesh_phases_lag_in_the_suns_direction() -> None:
+    # With 19 sun teeth and 3 planets the mesh phases are 0, 1/3, 2/3 (Parker & Lin 2004): a sun
+    # tooth that meshes with planet 0 reaches planet 1 (120 deg on, in the sun's direction of
+    # rotation relative to the carrier) 19/3 mesh periods later, so planet k's mesh repeats
+    # planet 0's gamma_k of a mesh period later in time. The models used to add the phase, which
+    # swapped planets 1 and 2 (the presets, 18 teeth, are in phase and were not affected).
+    sc = Scene.physical("rated").replace(**{"stage1.z_sun": 19}).replace(joints={"kind": "rigid"})
+    # Dynamic run: planet 1's mesh force is planet 0's delayed by T/3, planet 2's by 2T/3.
+    run = sc.replace(initial="steady", **{"drive.start": "step"})
+    period = 2 * math.pi / (19 * run["drive.speed"] * (1 - 1 / run.ratio))
+    res = simulate(run, 0.03, "dopri5", channels=["mesh"], record_interval=period / 96)
+    f = res.mesh_force[res.t > 0.01]
+
+    def delay(k: int) -> int:  # samples by which planet k's force best follows planet 0's
+        errs = [np.abs(f[96:, k] - np.roll(f[:, 0], s)[96:]).mean() for s in range(96)]
+        return int(np.argmin(errs))
+
+    assert abs(delay(1) - 32) <= 4 and abs(delay(2) - 64) <= 4, (delay(1), delay(2))
+    # LTCA, exactly: the sun is held and the carrier turns forward with the crank angle, so the
+    # mesh runs backwards along it and a delay of gamma_k in time is an advance of gamma_k P in
+    # crank angle: F_k(psi) = F_0(psi + gamma_k P), P = 2 pi zc / (z_planet zp) the tooth-mesh
+    # cycle in crank angle. The other sign would give F_k(psi) = F_0(psi - gamma_k P). The pin
+    # pattern does not repeat after gamma_k P, which moves the shares at the stiffness ramps by
+    # up to 2e-5: tolerance 1e-4 (the wrong sign is off by 0.2).
+    P = 2 * math.pi * 23 / (42 * 24)
+    n = 96
+    psi = np.arange(3 * n) * P / n
+    share = rvdyn.ltca(sc, 43921.0, psi).mesh_force
+    share = share / share.sum(axis=1, keepdims=True)
+    for k, lag in ((1, n // 3), (2, 2 * n // 3)):
+        assert np.abs(share[: 2 * n - lag, k] - share[lag : 2 * n, 0]).max() < 1e-4
+        assert np.abs(share[lag : 2 * n, k] - share[: 2 * n - lag, 0]).max() > 0.05

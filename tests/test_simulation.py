@@ -236,8 +236,11 @@ def test_sweep_runs_a_grid_and_reports_failures() -> None:
     peaks = [o.pin_force.max() for o in out]
     assert peaks[1] > peaks[0]
     bad = rvdyn.sweep([base, base], 0.05, "rk4", dt=5e-4, channels=["pins"])
-    # Issue 7: sweep returns Result objects with ok/error (it returned the exceptions).
+    # A failed point is a Result with ok/error (not the exception itself), and solve_ivp's
+    # names success/message say the same.
     assert all(not b.ok and isinstance(b.error, rvdyn.SimulationError) for b in bad)
+    assert all(not b.success and b.message.startswith("SimulationError: ") for b in bad)
+    assert all(o.success and o.message == "the run reached its end time t = 0.01 s" for o in out)
 
 
 def test_ctrl_c_stops_a_run_cleanly() -> None:

@@ -87,3 +87,27 @@ class OperatingPoint(NamedTuple):
     input_torque: float
     output_torque: float
     ratio: float
+
+
+def _document_fields(cls: type) -> None:
+    """Give each field of ``cls`` the description its class docstring's Attributes section
+    gives it (with the unit), instead of the named tuple's "Alias for field number N"."""
+    lines = (cls.__doc__ or "").splitlines()
+    docs: dict[str, list[str]] = {}
+    name = None
+    for line in lines:
+        text = line.strip()
+        head = text.split(" : ", 1)[0]
+        if " : " in text and head in cls._fields:  # type: ignore[attr-defined]
+            name = head
+            docs[name] = [text.split(" : ", 1)[1] + ":"]
+        elif name is not None and text and line.startswith(" " * 8):
+            docs[name].append(text)
+        elif name is not None and not text:
+            name = None
+    for field_name, words in docs.items():
+        getattr(cls, field_name).__doc__ = " ".join(words)
+
+
+for _cls in (GapResult, LineContact, OperatingPoint):
+    _document_fields(_cls)

@@ -139,6 +139,21 @@ class Result:
         return self.error is None
 
     @property
+    def success(self) -> bool:
+        """The same as ``ok`` (the name ``scipy.integrate.solve_ivp``'s result uses)."""
+        return self.error is None
+
+    @property
+    def message(self) -> str:
+        """Why the run ended, in words: that it reached its end time, or the exception's class
+        and text (``solve_ivp``'s ``message``)."""
+        if self.error is not None:
+            return f"{type(self.error).__name__}: {self.error}"
+        t = self._arrays.get("t")
+        end = f" t = {float(t[-1]):.6g} s" if t is not None and len(t) else ""
+        return f"the run reached its end time{end}"
+
+    @property
     def channels(self) -> list[str]:
         """Names of the recorded arrays."""
         return sorted(self._arrays)

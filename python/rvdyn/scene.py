@@ -216,7 +216,8 @@ class Scene:
 
     @property
     def ratio(self) -> float:
-        """Transmission ratio input speed / output speed (57 for the paper)."""
+        """Transmission ratio input speed / output speed [-] (57 for the paper). Negative
+        without a first stage (``-zc``: the output turns against the cranks)."""
         return float(self.model_info()["ratio"])
 
     # ------------------------------------------------------------------ value semantics

@@ -6,10 +6,14 @@ Rust core (``rvdyn._core``); docs/model.md, "Quasi-static analysis", gives the f
 conventions.
 
 Units are SI: N m, rad, m, N, Pa; results also offer arcmin/arcsec conversions.
+
+Every analysis is callable under its own name here (``rvdyn.analysis.modes(scene)``, as
+``rvdyn.modes``): the function takes the name of the submodule that holds it, as ``ltca`` does.
 """
 
 from __future__ import annotations
 
+from .campbell import CampbellDiagram, Crossing, campbell, travel_to_input_speed
 from .ltca import (
     ARCMIN,
     ARCSEC,
@@ -23,6 +27,8 @@ from .ltca import (
     torque_twist,
     transmission_error,
 )
+from .modes import MeshSweep, Modes, modes, modes_at, modes_over_mesh
+from .spectrum import ExcitationOrder, OrderSpectrum, SpectrumPeak, excitation_orders, order_spectrum
 
 __all__ = [
     "ARCMIN",
@@ -36,4 +42,18 @@ __all__ = [
     "tooth_mesh_angles",
     "torque_twist",
     "transmission_error",
+    "Modes",
+    "MeshSweep",
+    "modes",
+    "modes_at",
+    "modes_over_mesh",
+    "CampbellDiagram",
+    "Crossing",
+    "campbell",
+    "travel_to_input_speed",
+    "ExcitationOrder",
+    "OrderSpectrum",
+    "SpectrumPeak",
+    "excitation_orders",
+    "order_spectrum",
 ]

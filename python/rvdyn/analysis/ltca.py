@@ -204,7 +204,9 @@ class TeHarmonic:
 class TransmissionError:
     """TE over ``periods`` whole mesh periods (by default the ``window`` after which the whole
     TE repeats), forward (+torque) and reverse (-torque), loaded and at a light load
-    (unloaded) [rad]; ``crank_angle`` [rad], ``period`` (the mesh period) [rad].
+    (unloaded) [rad]; ``crank_angle`` [rad], ``period`` (the mesh period) [rad]. The arrays
+    ``crank_angle``, ``forward``, ``reverse``, ``unloaded_forward`` and ``unloaded_reverse`` all
+    have shape ``(n,)``, one value per crank angle.
     ``extremes[curve]`` holds each curve's largest and smallest TE located between the crank
     angles: ``max``, ``min`` [rad] at ``max_angle``, ``min_angle`` [rad]; ``refined[curve]``
     is false where the equilibria depend on the path (a very light load), and the extremes are
@@ -353,8 +355,9 @@ class TransmissionError:
 @dataclass(frozen=True, repr=False)
 class TwistLoop:
     """The torque-twist loop at one crank angle: ``torque`` [N m], ``twist`` [rad] (positive
-    with positive torque), ``tangent_stiffness`` [N m/rad]; catalogue ``rigidity`` [N m/rad],
-    ``lost_motion`` and ``backlash`` [rad] (docs/model.md, "Torque-twist loop")."""
+    with positive torque), ``tangent_stiffness`` [N m/rad], each of shape ``(points,)`` in the
+    loop's order; catalogue ``rigidity`` [N m/rad], ``lost_motion`` and ``backlash`` [rad]
+    (docs/model.md, "Torque-twist loop"); ``crank_angle`` [rad], ``rated_torque`` [N m]."""
 
     crank_angle: float
     rated_torque: float
@@ -373,7 +376,8 @@ class TwistLoop:
     def branches(self) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
         """The loop's upper (unloading, ``+rated -> -rated``) and lower (loading, ``-rated ->
         +rated``: the last quarter, then the first) branches as ``(torque, twist)`` pairs with
-        increasing torque. Without friction both are the same curve."""
+        increasing torque: torque [N m] and twist [rad], each of shape ``(m,)`` (about half the
+        loop's points). Without friction both are the same curve."""
         n = self.torque.size
         i_max = int(np.argmax(self.torque))
         i_min = int(np.argmin(self.torque))
@@ -485,10 +489,11 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
 
 
 def tooth_mesh_angles(scene: Scene) -> int:
-    """Crank angles per mesh period that place two in every tooth-mesh cycle of an ISO 6336
-    mesh (whose stiffness steps between one and two tooth pairs once per base pitch, passed
-    every ``2 pi zc / (z_planet zp)`` of crank angle with the input held; docs/model.md,
-    "Transmission error"); 2 for mesh laws that do not vary along the path of contact."""
+    """The number of crank angles per mesh period (an int) that places two in every tooth-mesh
+    cycle of an ISO 6336 mesh (whose stiffness steps between one and two tooth pairs once per
+    base pitch, passed every ``2 pi zc / (z_planet zp)`` of crank angle with the input held;
+    docs/model.md, "Transmission error"); 2 for mesh laws that do not vary along the path of
+    contact."""
     sc = _scene(scene)
     return _tooth_mesh_angles(sc, float(_core.LtcaSolver(sc._compiled, 1e-12).mesh_period))
 
@@ -628,9 +633,10 @@ def running_friction(scene: Scene, torque: float | None = None, points: int | No
     over one mesh period from ``start`` [rad] or (``window=True``) over the whole window after
     which everything repeats (``TransmissionError.window``): every contact slides as in the
     running reducer, the input driving against ``+torque`` (forward) and ``-torque``
-    (reverse) [N m]. Returns ``crank_angle`` [rad], TE ``forward`` / ``reverse`` [rad], the
-    held input's torque ``input_forward`` / ``input_reverse`` [N m] and the quasi-static
-    ``efficiency`` of each direction: the input work of the frictionless reducer over the same
+    (reverse) [N m]. Returns a dict of ``crank_angle`` [rad], TE ``forward`` / ``reverse``
+    [rad], the held input's torque ``input_forward`` / ``input_reverse`` [N m] (arrays of
+    shape ``(n,)``, one value per crank angle) and the quasi-static ``efficiency_forward`` /
+    ``efficiency_reverse`` [-] (floats) of each direction: the input work of the frictionless reducer over the same
     sweep divided by that with friction, ``mean(T_in,0) / mean(T_in)`` (docs/model.md, "Friction
     in the LTCA"). The frictionless sweep's work is the output work up to the elastic energy's
     change and the quadrature of the input torque's steps at the ISO mesh's zone changes; both

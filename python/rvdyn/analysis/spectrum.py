@@ -70,6 +70,7 @@ class SpectrumPeak:
 
     @property
     def label(self) -> str | None:
+        """The nearest excitation order's label (e.g. ``"pin pass x2"``), ``None`` if none."""
         return None if self.excitation is None else self.excitation.label
 
 

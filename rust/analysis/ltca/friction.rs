@@ -215,7 +215,7 @@ pub(crate) fn friction_forces(
             let dcr = [x[ci] - s[0], x[ci + 1] - s[1]];
             let (rbs, rbp) = (mm.sun_base_radius, mm.planet_base_radius);
             let rot = rbs * (x[SUN] - thc) + rbp * (x[ci + 2] - thc);
-            let s_mesh = rbs * (x[SUN] - thc) + mm.phases[i] * mm.base_pitch;
+            let s_mesh = rbs * (x[SUN] - thc) - mm.phases[i] * mm.base_pitch;
             for sigma in [1.0, -1.0] {
                 let w = [
                     sp * u[0] + sigma * cp * zu[0],

@@ -826,7 +826,7 @@ impl Statics {
                 let half = 0.5 * mm.backlash;
                 let idx = [SUN, CARRIER, ci + 2, ci, ci + 1];
                 // Mesh position along the line of action (the dynamic models' `s`).
-                let s_mesh = rbs * (x[SUN] - thc) + mm.phases[i] * mm.base_pitch;
+                let s_mesh = rbs * (x[SUN] - thc) - mm.phases[i] * mm.base_pitch;
                 let mut f_report = 0.0;
                 let mut e_drive = 0.0;
                 for sigma in [1.0, -1.0] {

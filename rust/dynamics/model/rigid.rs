@@ -413,7 +413,7 @@ impl RigidModel {
                         }
                         // The coast flank (sign -1) runs through its tooth pairs in the mirrored
                         // order: its mesh position is -s.
-                        let s_flank = sign * (s0 + m.phases[i] * m.base_pitch);
+                        let s_flank = sign * (s0 - m.phases[i] * m.base_pitch);
                         let (lf, dk) = m.law.evaluate(pen, pen_rate, s_flank, want_energy);
                         f = sign * lf.force;
                         out.q[CARRIER] += f * (m.sun_base_radius + m.planet_base_radius);

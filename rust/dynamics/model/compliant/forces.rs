@@ -107,7 +107,7 @@ impl CompliantModel {
                 let (rbs, rbp) = (mm.sun_base_radius, mm.planet_base_radius);
                 let rot = rbs * (x[SUN] - thc) + rbp * (alpha - thc);
                 let rot_rate = rbs * (v[SUN] - vc) + rbp * (va - vc);
-                let s_mesh = rbs * (x[SUN] - thc) + mm.phases[i] * mm.base_pitch;
+                let s_mesh = rbs * (x[SUN] - thc) - mm.phases[i] * mm.base_pitch;
                 let half = 0.5 * mm.backlash;
                 let w_drive = [sp * u[0] + cp * zu[0], sp * u[1] + cp * zu[1]];
                 let w_coast = [sp * u[0] - cp * zu[0], sp * u[1] - cp * zu[1]];
