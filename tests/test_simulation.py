@@ -267,6 +267,7 @@ def test_skipping_separated_pins_does_not_change_the_answer() -> None:
     assert np.max(np.abs(on.carrier_angle - off.carrier_angle)) < 1e-12
 
 
+@pytest.mark.filterwarnings("ignore:the scene's pin and sun/planet mesh contacts have no damping")
 def test_each_integrator_converges_at_its_order_on_a_smooth_scene() -> None:
     # A smooth version of the rated scene: contact force ~ x^3 (C2 at contact onset) and no
     # damping ramp, so steps see no kinks; errors against a converged dopri5 run (atol 1e-14).

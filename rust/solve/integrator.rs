@@ -48,9 +48,23 @@ impl Settings {
                 self.rtol
             ));
         }
-        if !(self.h_min.is_finite() && self.h_min > 0.0 && self.h_min <= self.h_max) {
+        if !(self.h_min.is_finite() && self.h_min > 0.0) {
             return bad(format!(
-                "the minimum step h_min = {:e} s must be > 0 and at most the largest step {:e} s",
+                "the minimum step h_min = {:e} s must be finite and > 0: e.g. 1e-13 s",
+                self.h_min
+            ));
+        }
+        if self.h_min > self.t_end {
+            return bad(format!(
+                "t_end = {:e} s is shorter than the adaptive method's minimum step h_min = {:e} \
+                 s: lower h_min below t_end",
+                self.t_end, self.h_min
+            ));
+        }
+        if self.h_min > self.h_max {
+            return bad(format!(
+                "the minimum step h_min = {:e} s is above the largest step {:e} s (for a \
+                 speed-driven scene an eighth of the pin-mesh period): lower h_min",
                 self.h_min, self.h_max
             ));
         }

@@ -227,7 +227,8 @@ fn check_stability(sys: &dyn MechanicalSystem, st: &State, h: f64) -> Result<()>
         return Err(RvdynError::Simulation(format!(
             "rk4 with dt = {h:.3e} s is beyond its stability limit at t = {:.6e} s: a mode of the \
              linearised reducer grows {growth:.3} times per step more than it should; the largest \
-             stable step here is about {limit:.3e} s: reduce dt below {:.2e} s or use \
+             stable step at this state is about {limit:.3e} s (loaded contacts are stiffer: a \
+             loaded state can need several times less): reduce dt below {:.2e} s or use \
              integrator=\"generalized-alpha\"",
             st.t,
             0.8 * limit

@@ -306,7 +306,7 @@ const OPEN_SLACK: f64 = 1e-12;
 pub(crate) fn penetration_error(t: f64, pen: f64, bound: f64, what: &str) -> RvdynError {
     RvdynError::Simulation(format!(
         "penetration {pen:.3e} m of {what} at t = {t:.6e} s exceeds the physical bound \
-         {bound:.3e} m (a tenth of the pin radius): in a run, either the motion has gone unstable \
+         {bound:.3e} m (a tenth of the pin radius, the model's bound for every contact): in a run, either the motion has gone unstable \
          (reduce the step dt or the tolerances; with an explicit integrator, use the implicit \
          integrator=\"generalized-alpha\"), the load is too heavy for the start (a speed step \
          against a large load inertia: start the drive with a ramp, drive.start = \"ramp\"), or \

@@ -458,6 +458,21 @@ fn default_mesh_ramp() -> f64 {
 }
 
 impl ContactLawSpec {
+    /// Whether the law dissipates nothing (zero damping, or restitution 1).
+    pub fn undamped(&self) -> bool {
+        use crate::contact::law::DampingSpec;
+        match self {
+            ContactLawSpec::Impact { max_damping, .. }
+            | ContactLawSpec::Palmgren { max_damping, .. } => *max_damping == 0.0,
+            ContactLawSpec::Line { damping, .. } | ContactLawSpec::Iso6336 { damping, .. } => {
+                match damping {
+                    DampingSpec::Restitution { restitution, .. } => *restitution == 1.0,
+                    DampingSpec::DampingRatio { ratio, .. } => *ratio == 0.0,
+                }
+            }
+        }
+    }
+
     /// The paper's IMPACT parameters (k = 3.988e5 N/mm^1.5, e = 1.5, cmax = 100 N s/mm,
     /// d = 0.01 mm) in SI.
     pub fn paper() -> Self {
