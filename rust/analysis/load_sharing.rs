@@ -58,6 +58,23 @@ pub fn classical_pin_forces(
 
 /// Lever `l_j = rc' sin(phi_j) / S_j` \[m\] of each pin's contact normal about the disc centre
 /// for the disc centre at crank angle `crank_angle` \[rad\].
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::analysis::classical_levers;
+/// use rvdyn::contact::pin_tangent::pin_gap_jet;
+/// use rvdyn::geometry::{CycloidGeometry, cycloid::CycloidParams};
+/// let g = CycloidGeometry::new(CycloidParams::paper()).unwrap();
+/// let psi: f64 = 0.3;
+/// let levers = classical_levers(&g, psi);
+/// // The lever of the exact contact normal in the kinematic pose is the same.
+/// let (centre, angle) = ([4.5e-3 * psi.cos(), 4.5e-3 * psi.sin()], -psi / 23.0);
+/// let th = g.pin_angle(3);
+/// let pin = [0.15 * th.cos(), 0.15 * th.sin()];
+/// let jet = pin_gap_jet(&g, pin, 0.010, centre, angle, th - angle).unwrap();
+/// assert!((levers[3] - jet.lever()).abs() < 1e-12); // 97.6 mm
+/// ```
 pub fn classical_levers(geometry: &CycloidGeometry, crank_angle: f64) -> Vec<f64> {
     let k1 = geometry.k1();
     let rc = geometry.pitch_radius();

@@ -155,6 +155,16 @@ pub fn fc_line_contact(gamma: f64) -> Result<f64> {
 ///
 /// Returns infinity for `P = 0` (no load, no fatigue). Errors (`Parameter`) for a non-positive
 /// rating or a negative or non-finite load.
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::bearing::l10_roller;
+/// // C = 80 kN, P = 10 kN: (C/P)^(10/3) = 8^(10/3) = 2^10 = 1024 million revolutions.
+/// let life = l10_roller(80e3, 10e3).unwrap();
+/// assert!((life - 1024.0).abs() < 1e-9);
+/// assert_eq!(l10_roller(80e3, 0.0).unwrap(), f64::INFINITY);
+/// ```
 pub fn l10_roller(rating: f64, equivalent_load: f64) -> Result<f64> {
     require_positive("dynamic load rating", rating, "N")?;
     require_non_negative("equivalent dynamic load", equivalent_load, "N")?;
@@ -170,6 +180,19 @@ pub fn l10_roller(rating: f64, equivalent_load: f64) -> Result<f64> {
 ///
 /// Errors (`Parameter`) for different lengths, an empty history, a negative or non-finite
 /// load or weight, or all-zero weights.
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::bearing::{equivalent_load, l10_roller};
+/// // 3/4 of the revolutions at 10 kN, 1/4 at 20 kN.
+/// let p = equivalent_load(&[10e3, 20e3], &[3.0, 1.0]).unwrap();
+/// // The life at P is the Palmgren-Miner sum of the lives at each load.
+/// let c = 80e3;
+/// let (l1, l2) = (l10_roller(c, 10e3).unwrap(), l10_roller(c, 20e3).unwrap());
+/// let miner = 1.0 / (0.75 / l1 + 0.25 / l2);
+/// assert!((l10_roller(c, p).unwrap() / miner - 1.0).abs() < 1e-12);
+/// ```
 pub fn equivalent_load(loads: &[f64], revolutions: &[f64]) -> Result<f64> {
     if loads.len() != revolutions.len() || loads.is_empty() {
         return Err(RvdynError::Parameter(format!(

@@ -67,6 +67,15 @@ impl Material {
 /// Returns `E*` with `1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2`. The paper's eq. 8 subtracts the
 /// two terms (docs/model.md#erratum-1), which is zero for equal materials; the sum is Hertz's.
 /// Two paper steels give `E* = 2.17e11 / (2 * 0.91) = 1.1923e11 Pa`.
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::contact::{Material, effective_modulus};
+/// let steel = Material::steel(); // E = 2.17e11 Pa, nu = 0.3
+/// let e_star = effective_modulus(&steel, &steel);
+/// assert!((e_star - 2.17e11 / (2.0 * (1.0 - 0.3 * 0.3))).abs() < 1.0); // 1.1923e11 Pa
+/// ```
 pub fn effective_modulus(m1: &Material, m2: &Material) -> f64 {
     1.0 / (m1.compliance() + m2.compliance())
 }
@@ -133,6 +142,22 @@ pub struct LineContact {
 /// material, results beyond floating point, or a half-width wider than the smaller radius
 /// (outside Hertz theory); `Geometry` from [`effective_radius`]. Zero force gives all-zero
 /// output.
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::contact::{Material, hertz_line_contact};
+/// use std::f64::consts::PI;
+/// // Two steel cylinders of radius 20 mm (R = 10 mm), 10 kN over 40 mm.
+/// let steel = Material::steel();
+/// let (force, length) = (10e3, 0.040);
+/// let c = hertz_line_contact(force, length, 0.020, 0.020, &steel, &steel).unwrap();
+/// // a = sqrt(4 P R / (pi E*)) with P = F/L and E* = E / (2 (1 - nu^2)).
+/// let a = (4.0 * force / length * 0.010 / (PI * 2.17e11 / 1.82)).sqrt();
+/// assert!((c.half_width - a).abs() < 1e-12 * a); // 0.163 mm
+/// // The elliptic pressure over the strip carries the force: (pi/2) p0 a L = F.
+/// assert!((PI / 2.0 * c.peak_pressure * c.half_width * length - force).abs() < 1e-6);
+/// ```
 pub fn hertz_line_contact(
     force: f64,
     length: f64,

@@ -507,7 +507,9 @@ impl MeshLaw {
     }
 }
 
-/// Check a material given in a scene (`E > 0`, `-1 < nu < 0.5`), naming the family.
+/// Check a material given in a scene: Young's modulus `youngs_modulus` `E` \[Pa\] (`> 0`) and
+/// Poisson's ratio `poisson_ratio` `nu` [-] (`-1 < nu < 0.5`); an error (`Scene`) names the
+/// contact family `family` (e.g. `"pin"`) as `contact.<family>`.
 pub fn scene_material(family: &str, youngs_modulus: f64, poisson_ratio: f64) -> Result<Material> {
     Material::new(youngs_modulus, poisson_ratio)
         .map_err(|e| RvdynError::Scene(format!("contact.{family}: {e}")))

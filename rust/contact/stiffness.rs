@@ -233,6 +233,18 @@ pub fn contact_stiffness_terms(width: f64, p: &StiffnessParams) -> Result<Stiffn
 ///
 /// Returns `k` of eq. 5 (see the module doc for the unit convention and for how it compares
 /// with the paper). Errors as [`contact_stiffness_terms`].
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::contact::{ContactCondition, StiffnessParams, contact_stiffness};
+/// let p = StiffnessParams::paper(ContactCondition::ConvexConvex); // e = 1.5
+/// let k = contact_stiffness(0.005, &p).unwrap(); // 5 mm contact width
+/// let per_mm = k / 1000f64.powf(1.5); // N/m^1.5 -> N/mm^1.5
+/// assert!((per_mm - 2.8409e4).abs() < 1.0); // 14x below the paper's 3.988e5 N/mm^1.5
+/// // The corrected formula decreases with width (no maximum near 5 mm).
+/// assert!(contact_stiffness(0.010, &p).unwrap() < k);
+/// ```
 pub fn contact_stiffness(width: f64, p: &StiffnessParams) -> Result<f64> {
     contact_stiffness_terms(width, p).map(|t| t.stiffness)
 }

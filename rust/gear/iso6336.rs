@@ -214,6 +214,22 @@ pub fn rim_blank_factor(
 ///
 /// Errors (`Parameter`) for tooth counts below 5, a non-positive module, a pressure angle
 /// outside (0, 45 deg).
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::gear::spur_contact_ratio;
+/// use std::f64::consts::PI;
+/// // The paper's first stage: 18/42 teeth, module 3 mm, 20 deg.
+/// let alpha = 20f64.to_radians();
+/// let eps = spur_contact_ratio(18, 42, 3e-3, alpha).unwrap();
+/// // Textbook form in tooth counts (addendum = module, so the module cancels).
+/// let (z1, z2, c) = (18.0_f64, 42.0_f64, alpha.cos());
+/// let path = |z: f64| ((z + 2.0).powi(2) - (z * c).powi(2)).sqrt();
+/// let eps_z = (path(z1) + path(z2) - (z1 + z2) * alpha.sin()) / (2.0 * PI * c);
+/// assert!((eps - eps_z).abs() < 1e-12);
+/// assert!((eps - 1.626).abs() < 1e-3);
+/// ```
 pub fn spur_contact_ratio(z1: u32, z2: u32, module: f64, pressure_angle: f64) -> Result<f64> {
     IsoGearPair::spur(z1, z2, module, pressure_angle, 1.0).validate()?;
     let (s, c) = pressure_angle.sin_cos();
@@ -388,6 +404,19 @@ impl MeshStiffnessWave {
 /// (R. G. Parker, J. Lin, *Mesh phasing relationships in planetary and epicyclic gears*, J.
 /// Mech. Des. 126 (2004) 365-370, sun-planet phases). Equal spacing with `z_sun / N` an integer
 /// gives all phases 0 (in phase). Errors (`Parameter`) for a non-finite angle.
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::gear::planet_mesh_phases;
+/// use std::f64::consts::TAU;
+/// let three = [0.0, TAU / 3.0, 2.0 * TAU / 3.0]; // three equally spaced planets
+/// // 18 sun teeth: 18 / 3 is whole, the meshes are in phase.
+/// assert_eq!(planet_mesh_phases(18, &three).unwrap(), vec![0.0; 3]);
+/// // 19 sun teeth: sequential phases 0, 1/3, 2/3 of a mesh period.
+/// let g = planet_mesh_phases(19, &three).unwrap();
+/// assert!((g[1] - 1.0 / 3.0).abs() < 1e-12 && (g[2] - 2.0 / 3.0).abs() < 1e-12);
+/// ```
 pub fn planet_mesh_phases(z_sun: u32, planet_angles: &[f64]) -> Result<Vec<f64>> {
     planet_angles
         .iter()

@@ -34,6 +34,17 @@ pub struct OperatingPoint {
 /// Returns speeds and torques with `input_torque * input_speed = output_torque * output_speed
 /// = power`. Errors (`RvdynError::Parameter`) for non-finite values or a zero input speed or
 /// ratio (the torque would be infinite).
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::kinematics::operating_point;
+/// // The paper's section 4.1: 112 kW at 8328 deg/s through i = 57.
+/// let op = operating_point(112e3, 8328f64.to_radians(), 57.0).unwrap();
+/// assert!((op.input_torque - 770.55).abs() < 0.01); // 112e3 W / 145.351 rad/s
+/// assert!((op.output_torque - 57.0 * op.input_torque).abs() < 1e-9);
+/// assert!((op.output_torque * op.output_speed - 112e3).abs() < 1e-6); // no losses
+/// ```
 pub fn operating_point(power: f64, input_speed: f64, ratio: f64) -> Result<OperatingPoint> {
     require_finite("power", power)?;
     require_finite("input speed", input_speed)?;

@@ -14,6 +14,15 @@ use crate::error::{Result, RvdynError, num, require_finite};
 ///
 /// Returns 57 for the paper (18, 42, 24). Errors (`RvdynError::Geometry`) if `z_sun` or
 /// `z_planet` is 0 or `pins < 3`.
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::kinematics::transmission_ratio;
+/// // The paper's reducer: sun 18, planet 42, 24 pins: 1 + (42/18) 24 = 57.
+/// assert_eq!(transmission_ratio(18, 42, 24).unwrap(), 57.0);
+/// assert!(transmission_ratio(18, 42, 2).is_err()); // a cycloid stage needs 3 pins
+/// ```
 pub fn transmission_ratio(z_sun: u32, z_planet: u32, pins: u32) -> Result<f64> {
     if z_sun < 1 || z_planet < 1 {
         return Err(RvdynError::Geometry(format!(
@@ -54,6 +63,17 @@ pub struct BodySpeeds {
 /// `= carrier + phi'`, disc spin `= carrier`, disc orbit `= crank absolute`, sun `= input`.
 /// Errors: a non-finite input speed (`Parameter`) or the tooth-count errors of
 /// [`transmission_ratio`].
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::kinematics::body_speeds;
+/// let w_in = 8328f64.to_radians(); // the paper's input speed, 145.35 rad/s
+/// let s = body_speeds(w_in, 18, 42, 24).unwrap();
+/// assert!((s.carrier - w_in / 57.0).abs() < 1e-12);
+/// // Cycloid kinematics: a disc with zc = 23 lobes turns by -1/zc of its orbit.
+/// assert!((s.disc_spin + s.disc_orbit / 23.0).abs() < 1e-12);
+/// ```
 pub fn body_speeds(input_speed: f64, z_sun: u32, z_planet: u32, pins: u32) -> Result<BodySpeeds> {
     require_finite("input speed", input_speed)?;
     let carrier = input_speed / transmission_ratio(z_sun, z_planet, pins)?;

@@ -130,7 +130,10 @@ impl AdaptiveAlpha {
         })
     }
 
-    /// Weighted RMS norm of the local error of `a` (see the module documentation).
+    /// Weighted RMS norm [-] of the local error of the attempt `a` from the state `st` (see the
+    /// module documentation): each coordinate's error is taken at its lever
+    /// (`MechanicalSystem::length_scale`, \[m\] per unit) against `atol` \[m\] and `rtol`, so
+    /// the step is accepted at a norm of at most 1.
     pub fn error_norm(
         &self,
         sys: &(impl MechanicalSystem + ?Sized),

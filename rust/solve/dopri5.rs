@@ -153,8 +153,9 @@ impl Dopri5 {
         }
     }
 
-    /// Take one accepted step, not past `t_stop`; rejected tries are retried with a smaller
-    /// step. Fails with `SimulationError` when the step collapses below `h_min`.
+    /// Take one accepted step of `st` (in place: `t` \[s\], and `q`, `v` in the system's units),
+    /// not past `t_stop` \[s\]; rejected tries are retried with a smaller step. Fails with
+    /// `SimulationError` when the step collapses below `h_min` \[s\].
     pub fn step<S: MechanicalSystem + ?Sized>(
         &mut self,
         sys: &S,

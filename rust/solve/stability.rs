@@ -32,8 +32,8 @@ pub fn rk4_amplification(z: Complex<f64>) -> f64 {
     (one + z * (one + z * (one / 2.0 + z * (one / 6.0 + z / 24.0)))).norm()
 }
 
-/// How much RK4 with step `h` amplifies a mode beyond its exact growth, worst over `eigs`
-/// (> 1: numerically unstable).
+/// How much RK4 with step `h` \[s\] amplifies a mode beyond its exact growth, worst over the
+/// eigenvalues `eigs` [1/s] (a ratio [-]; > 1: numerically unstable).
 pub fn rk4_excess_growth(eigs: &[Complex<f64>], h: f64) -> f64 {
     eigs.iter()
         .map(|l| {
@@ -43,8 +43,8 @@ pub fn rk4_excess_growth(eigs: &[Complex<f64>], h: f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The largest step at which RK4 does not amplify any of `eigs` beyond its exact growth
-/// (bisection below `h`).
+/// The largest step \[s\] at which RK4 does not amplify any of the eigenvalues `eigs` [1/s]
+/// beyond its exact growth (bisection below the step `h` \[s\]).
 pub fn rk4_step_limit(eigs: &[Complex<f64>], h: f64) -> f64 {
     let (mut lo, mut hi) = (0.0, h);
     for _ in 0..60 {

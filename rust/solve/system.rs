@@ -49,7 +49,10 @@ pub struct State {
 }
 
 impl State {
-    /// A state at `t` with accelerations evaluated from the system.
+    /// A state at `t` \[s\] with accelerations evaluated from the system.
+    ///
+    /// `q` and `v` hold [`MechanicalSystem::dof`] values each, in the system's units (for the
+    /// reducer models angles \[rad\] or positions \[m\], and their speeds [rad/s] or [m/s]).
     pub fn new<S: MechanicalSystem>(sys: &S, t: f64, q: Vec<f64>, v: Vec<f64>) -> Result<Self> {
         let mut a = vec![0.0; q.len()];
         let mut p = [0.0; 3];
@@ -64,8 +67,9 @@ impl State {
         })
     }
 
-    /// Cubic Hermite interpolation between `self` and `next` at time `t`: positions from
-    /// (q, v), velocities from (v, a); work linearly.
+    /// Cubic Hermite interpolation between `self` and `next` at time `t` \[s\] (clamped to
+    /// `[self.t, next.t]`): positions from (q, v), velocities from (v, a); accelerations,
+    /// power flows and work linearly. The result is in the units of the two states.
     pub fn interpolate(&self, next: &State, t: f64) -> State {
         let h = next.t - self.t;
         let s = if h > 0.0 {

@@ -483,7 +483,9 @@ impl Ltca {
         self.statics.evaluations
     }
 
-    /// The unknowns of the last equilibrium found (empty before the first).
+    /// The unknowns of the last equilibrium found (empty before the first): angles \[rad\] and,
+    /// with compliant joints, positions \[m\], laid out as in
+    /// [`Statics::kinematic_unknowns`].
     pub fn last_unknowns(&self) -> &[f64] {
         self.history.first().map_or(&[], |s| &s.q)
     }
@@ -1016,9 +1018,11 @@ impl Ltca {
         }
     }
 
-    /// The torque-twist loop at crank angle `psi`: `points` torques along
-    /// 0 -> +rated -> -rated -> 0 with rigidity, lost motion and backlash (catalogue
-    /// definitions, docs/model.md), with the scene's friction if it has any.
+    /// The torque-twist loop at crank angle `psi` \[rad\]: `points` (at least 8) output torques
+    /// [N m] along 0 -> +rated -> -rated -> 0 for the rated torque `rated` [N m] (its
+    /// magnitude), with the output twists \[rad\], rigidity [N m/rad], lost motion and
+    /// backlash \[rad\] (catalogue definitions, docs/model.md), with the scene's friction if it
+    /// has any.
     pub fn twist_loop(&mut self, rated: f64, psi: f64, points: usize) -> Result<TwistLoop> {
         self.twist_loop_with(rated, psi, points, true)
     }

@@ -473,7 +473,9 @@ impl Statics {
         }
     }
 
-    /// The full kinematic pose at crank angle `psi` (bearings undeflected, no mesh deflection).
+    /// The full kinematic pose at crank angle `psi` \[rad\] (bearings undeflected, no mesh
+    /// deflection): [`full_len`](Self::full_len) coordinates in the module doc's order, angles
+    /// \[rad\] and positions \[m\].
     pub fn kinematic_full(&self, psi: f64) -> Vec<f64> {
         let m = &self.model;
         let mut x = vec![0.0; self.full_len()];
@@ -502,7 +504,10 @@ impl Statics {
         x
     }
 
-    /// The unknowns of the kinematic pose at crank angle `psi`.
+    /// The unknowns of the kinematic pose at crank angle `psi` \[rad\]: [`dim`](Self::dim)
+    /// values, `[th_c, alpha]` (or `[th_c]` without a first stage) \[rad\] for rigid joints,
+    /// the full coordinates listed in [`unknowns`](Self::unknowns) (angles \[rad\], positions
+    /// \[m\]) for compliant ones.
     pub fn kinematic_unknowns(&self, psi: f64) -> Vec<f64> {
         match self.kind {
             Kind::Rigid => {
@@ -520,7 +525,10 @@ impl Statics {
         }
     }
 
-    /// Full coordinates from the unknowns `q` with the input held at crank angle `psi`.
+    /// Full coordinates (angles \[rad\], positions \[m\]; [`full_len`](Self::full_len) values)
+    /// from the unknowns `q` ([`dim`](Self::dim) values, laid out as in
+    /// [`kinematic_unknowns`](Self::kinematic_unknowns)) with the input held at crank angle
+    /// `psi` \[rad\].
     pub fn full(&self, psi: f64, q: &[f64]) -> Vec<f64> {
         let mut x = Vec::new();
         self.full_into(psi, q, &mut x);

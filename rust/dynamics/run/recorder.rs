@@ -590,7 +590,9 @@ impl Recorder {
         Ok(())
     }
 
-    /// Record the free state `(q, v)` at `t` with integrated `work`.
+    /// Record the free state `(q, v)` at `t` \[s\] with integrated `work` \[J\] (`[input,
+    /// output, dissipated]`). `q` [rad or m] and `v` [rad/s or m/s] hold one value per free
+    /// coordinate, in `ReducerModel::initial_state` order.
     pub fn sample<M: ReducerModel>(
         &mut self,
         model: &M,

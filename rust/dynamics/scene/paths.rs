@@ -4,6 +4,21 @@
 use crate::error::{Result, RvdynError};
 
 /// The value at dotted `path` of a scene tree.
+///
+/// Each key is an object field or a list index. Errors (`Scene`) for an empty path or an
+/// empty key (`"a..b"`), or a field the tree does not have (the message names the key where
+/// the path stops).
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::dynamics::scene::{Scene, get_path};
+/// let tree = serde_json::to_value(Scene::paper("idle").unwrap()).unwrap();
+/// assert_eq!(get_path(&tree, "cycloid.pins").unwrap(), 24);
+/// // The second disc sits half a turn round the crank [rad].
+/// assert_eq!(get_path(&tree, "discs.1.phase").unwrap(), std::f64::consts::PI);
+/// assert!(get_path(&tree, "discs.2.phase").is_err()); // two discs only
+/// ```
 pub fn get_path<'a>(tree: &'a serde_json::Value, path: &str) -> Result<&'a serde_json::Value> {
     let mut node = tree;
     for key in path_keys(path)? {

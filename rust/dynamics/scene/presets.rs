@@ -26,6 +26,18 @@ pub const PHYSICAL_REFERENCE_FREQUENCY: f64 = 1670.0;
 /// clearance; each crankshaft in the carrier on two roller bearings lumped as one row of
 /// 20 rollers of 7 mm x 24 mm on a 50 mm pitch diameter, 5 um radial clearance. Roller damping
 /// as the contacts.
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::dynamics::scene::{Joints, Scene, physical_joints};
+/// let joints = physical_joints();
+/// let Joints::Compliant { eccentric_bearing, crank_bearing } = joints else { unreachable!() };
+/// let needles = eccentric_bearing.rollers.unwrap();
+/// assert_eq!((needles.count, needles.diameter, needles.length), (26, 0.005, 0.030)); // [m]
+/// assert_eq!(crank_bearing.unwrap().clearance, 5e-6); // [m]
+/// assert_eq!(Scene::physical("idle").unwrap().joints, joints);
+/// ```
 pub fn physical_joints() -> Joints {
     let rollers = |count, length, diameter, pitch_diameter| Rollers {
         count,

@@ -358,6 +358,9 @@ impl CompliantModel {
 
     /// Full kinematic state `(x, v)` at t = 0: kinematic pose, bearings undeflected, at rest
     /// or at kinematic speed (`Initial::Steady`); prescribed coordinates from the drive.
+    ///
+    /// Both have [`full_len`](Self::full_len) entries in the order of the module doc: `x`
+    /// angles \[rad\] and positions \[m\], `v` their speeds [rad/s] and [m/s].
     pub fn full_initial_state(&self) -> (Vec<f64>, Vec<f64>) {
         let m = &self.parts;
         let n_full = self.full_len();
@@ -434,7 +437,12 @@ impl CompliantModel {
         acc
     }
 
-    /// Full coordinates from free ones at `t`; returns `(x, v, prescribed acceleration)`.
+    /// Full coordinates from free ones at `t` \[s\]; returns `(x, v, prescribed acceleration)`.
+    ///
+    /// `q` [rad or m] and `v` [rad/s or m/s] are the free coordinates and velocities
+    /// (`ReducerModel::initial_state` order). `x` and `v` returned have
+    /// [`full_len`](Self::full_len) entries in the order of the module doc (angles \[rad\],
+    /// positions \[m\] and their speeds); the prescribed (input) acceleration is in [rad/s^2].
     pub fn full(&self, t: f64, q: &[f64], v: &[f64]) -> (Vec<f64>, Vec<f64>, f64) {
         let n_full = self.full_len();
         let mut x = vec![0.0; n_full];
