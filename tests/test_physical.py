@@ -207,3 +207,15 @@ def test_planet_mesh_phases_lag_in_the_suns_direction() -> None:
     for k, lag in ((1, n // 3), (2, 2 * n // 3)):
         assert np.abs(share[: 2 * n - lag, k] - share[lag : 2 * n, 0]).max() < 1e-4
         assert np.abs(share[lag : 2 * n, k] - share[: 2 * n - lag, 0]).max() > 0.05
+
+
+def test_roller_bearing_life_is_iso_281_and_checks_its_input() -> None:
+    # P = (sum w P^(10/3) / sum w)^(3/10), L10 = (C/P)^(10/3) (ISO 281), computed here by hand.
+    loads, revs = [10e3, 20e3, 0.0], [3.0, 1.0, 2.0]
+    p, l10 = rvdyn._core.roller_bearing_life(80e3, loads, revs)
+    p_hand = ((3 * 10e3 ** (10 / 3) + 20e3 ** (10 / 3)) / 6.0) ** 0.3
+    assert p == pytest.approx(p_hand, rel=1e-13) and l10 == pytest.approx((80e3 / p_hand) ** (10 / 3), rel=1e-12)
+    assert rvdyn._core.roller_bearing_life(80e3, [5e3, 6e3], [0.0, 0.0]) == (0.0, math.inf)  # did not turn
+    for bad in ((0.0, [1.0], [1.0]), (80e3, [-1.0], [1.0]), (80e3, [1.0, 2.0], [1.0]), (80e3, [], [])):
+        with pytest.raises(rvdyn.ParameterError):
+            rvdyn._core.roller_bearing_life(*bad)

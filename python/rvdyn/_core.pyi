@@ -300,6 +300,10 @@ def hertz_line_contact(
     convex, negative concave), broadcast: half_width [m], peak_pressure [Pa], mean_pressure
     [Pa], approach [m]."""
 
+def roller_bearing_life(rating: float, loads: Sequence[float], revolutions: Sequence[float]) -> tuple[float, float]:
+    """Equivalent load P [N] and ISO 281 L10 [million revolutions] of a roller bearing of rating C
+    [N] over loads [N] weighted by revolutions; (0, inf) for a bearing that did not turn."""
+
 def impact_force(
     penetration: ArrayLike,
     velocity: ArrayLike,

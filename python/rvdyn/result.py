@@ -348,10 +348,12 @@ class Result:
             rev = np.abs(np.diff(rel, axis=0)) / (2 * np.pi)
             load = 0.5 * (mag[1:] + mag[:-1])
             total = rev.sum(axis=0)
-            p_eq = (np.sum(load ** (10 / 3) * rev, axis=0) / np.where(total > 0, total, 1.0)) ** 0.3
-            worst = np.unravel_index(int(np.argmax(p_eq)), p_eq.shape)
-            p = float(p_eq[worst])
-            l10 = (rating / p) ** (10 / 3) if p > 0 else math.inf
+            # ISO 281 per bearing in the core: (equivalent load, L10); the worst is the largest load.
+            lives = {j: _core.roller_bearing_life(rating, load[(slice(None), *j)].tolist(),
+                                                  rev[(slice(None), *j)].tolist())
+                     for j in np.ndindex(*load.shape[1:])}
+            worst = max(lives, key=lambda j: lives[j][0])
+            p, l10 = lives[worst]
             rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
             peak = float(mag.max())
             s0 = static / peak if peak > 0 else math.inf

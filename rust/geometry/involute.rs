@@ -203,11 +203,16 @@ impl InvoluteStage {
         } else {
             "more teeth".to_string()
         };
+        // Generation by a standard rack (ISO 53) undercuts a gear of fewer than 2 / sin^2(alpha)
+        // teeth (Niemann & Winter; 17.1 at 20 deg), which this tip rule does not see: a
+        // 15-tooth sun passes it while a 42-tooth planet's tip reaches into its undercut.
+        let undercut_free = (2.0 / (sin_a * sin_a)).ceil();
         Err(RvdynError::Geometry(format!(
             "involute interference: the tip of the {z_other}-tooth {other} reaches below the base \
              circle of the {z_small}-tooth {small} (pressure angle {:.1} deg), where a standard \
              gear has no involute (it is undercut); rvdyn models unshifted full involutes only: \
-             use {remedy} or a larger pressure angle",
+             use {remedy} or a larger pressure angle (a gear cut by a standard rack is free of \
+             undercut from {undercut_free} teeth, 2 / sin^2 of the pressure angle)",
             self.pressure_angle.to_degrees(),
         )))
     }

@@ -8,6 +8,7 @@
 //! module; a new submodule (e.g. `simulate`) adds `mod simulate;` and one `register` line in
 //! [`rvdyn_core`].
 
+mod bearing;
 mod contact;
 mod errors;
 mod geometry;
@@ -37,6 +38,7 @@ fn rvdyn_core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     geometry::register(m)?;
     contact::register(m)?;
+    bearing::register(m)?;
     kinematics::register(m)?;
     scene::register(m)?;
     simulate::register(m)?;
