@@ -4,7 +4,7 @@
 //! meshes, roller bearings with clearance) at rated torque (`ltca_physical/...`).
 use criterion::{Criterion, criterion_group, criterion_main};
 use rvdyn::analysis::ltca::Ltca;
-use rvdyn::dynamics::compliant::default_joints;
+use rvdyn::dynamics::model::compliant::default_joints;
 use rvdyn::dynamics::scene::{ContactLawSpec, Scene};
 use std::hint::black_box;
 
