@@ -217,10 +217,7 @@ pub fn rv_efficiency(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     #[test]
     fn pin_loss_closed_form_by_hand() {

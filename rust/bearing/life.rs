@@ -256,10 +256,7 @@ impl PalmgrenFriction {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     #[test]
     fn fc_by_hand() {

@@ -125,11 +125,6 @@ impl RollerBearing {
         self.clearance
     }
 
-    /// Roller constant `K_n` [N/m^(10/9)]: `Q = K_n delta^(10/9)`.
-    pub fn roller_constant(&self) -> f64 {
-        self.k_si
-    }
-
     /// Load `Q` \[N\] and slope `dQ/d delta` [N/m] of one roller compressed by `delta` \[m\]
     /// (0 and 0 for `delta <= 0`).
     #[inline]
@@ -299,10 +294,7 @@ pub const RADIAL_INTEGRAL_HALF: f64 = 0.244_798_558_710;
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     #[test]
     fn radial_integral_by_quadrature() {

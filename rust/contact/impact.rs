@@ -214,6 +214,7 @@ impl ImpactLaw {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_util::close;
 
     #[test]
     fn elastic_energy_is_the_integral_of_the_elastic_force() {
@@ -227,10 +228,6 @@ mod tests {
         assert!((integral - law.elastic_energy(x)).abs() < 1e-7 * law.elastic_energy(x));
         assert_eq!(law.elastic_energy(-1.0), 0.0);
         assert_eq!(law.elastic_force(0.0), 0.0);
-    }
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
     }
 
     #[test]

@@ -348,10 +348,7 @@ impl InvoluteStage {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     fn paper() -> InvoluteStage {
         InvoluteStage::new(18, 42, 3, 0.003, 20f64.to_radians(), 0.030).unwrap()
