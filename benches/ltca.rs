@@ -30,7 +30,7 @@ fn bench_ltca(c: &mut Criterion) {
     });
 }
 
-/// The workload issue 9 names with the physical preset's pin law: two discs of 24 pins, the
+/// The paper's scene with the physical preset's pin law: two discs of 24 pins, the
 /// line-contact (Johnson) law with its location term, linear compliant bearings, the paper's
 /// constant mesh stiffness. It separates what the physical preset's roller bearings with
 /// clearance and ISO meshes cost from what its pin law costs.

@@ -1,5 +1,5 @@
-"""The error-controlled generalized-alpha, interpolated output and the fixed-step check
-(issue 13). Tolerances are stated where used, with the reason."""
+"""The error-controlled generalized-alpha, interpolated output and the fixed-step check.
+Tolerances are stated where used, with the reason."""
 
 from __future__ import annotations
 

@@ -236,7 +236,7 @@ def test_sweep_runs_a_grid_and_reports_failures() -> None:
     peaks = [o.pin_force.max() for o in out]
     assert peaks[1] > peaks[0]
     bad = rvdyn.sweep([base, base], 0.05, "rk4", dt=5e-4, channels=["pins"])
-    # Issue 7: sweep returns Result objects with ok/error (it returned the exceptions).
+    # A failed run in a sweep is a Result with ok/error, not the exception object.
     assert all(not b.ok and isinstance(b.error, rvdyn.SimulationError) for b in bad)
 
 
