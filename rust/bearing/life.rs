@@ -26,7 +26,7 @@
 //!
 //! Basic static radial load rating of a radial roller bearing (ISO 76:2006, *Rolling bearings -
 //! Static load ratings*): `C0r = 44 (1 - D_we cos alpha / D_pw) i Z L_we D_we cos alpha` [N,
-//! with lengths in mm], the load at which the most loaded roller's contact reaches 4000 MPa and a
+//! with lengths in mm], the load at which the most loaded roller's contact reaches `4000 MPa` and a
 //! permanent deformation of about 1e-4 of the roller diameter. The static safety factor
 //! `s0 = C0r / P0` (`P0` the peak radial load) should be at least 1 (ISO 76 gives 1-3 by
 //! application); below it the raceways yield and an elastic roller law no longer holds.

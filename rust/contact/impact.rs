@@ -55,8 +55,8 @@ impl ImpactLaw {
     /// Build a validated law from stiffness [N/m^exponent], exponent [-], maximum damping
     /// [N s/m] and damping depth \[m\].
     ///
-    /// Errors (`RvdynError::Parameter`) if any value is not finite, stiffness <= 0,
-    /// exponent < 1, max_damping < 0 or damping_depth <= 0.
+    /// Errors (`RvdynError::Parameter`) if any value is not finite, `stiffness <= 0`,
+    /// `exponent < 1`, `max_damping < 0` or `damping_depth <= 0`.
     pub fn new(
         stiffness: f64,
         exponent: f64,

@@ -1,7 +1,7 @@
 //! Gear mesh stiffness by ISO 6336-1 method B, and its variation along the line of action.
 //!
 //! ISO 6336-1 (*Calculation of load capacity of spur and helical gears, Part 1*, 2006 and
-//! 2019 editions), tooth stiffness parameters c' and c_gamma, method B:
+//! 2019 editions), tooth stiffness parameters `c'` and `c_gamma`, method B:
 //!
 //! - `q' = C1 + C2/zn1 + C3/zn2 + C4 x1 + C5 x1/zn1 + C6 x2 + C7 x2/zn2 + C8 x1^2 + C9 x2^2`
 //!   [mm um / N] with `C1..C9 = 0.04723, 0.15551, 0.25791, -0.00635, -0.11654, -0.00193,

@@ -632,7 +632,6 @@ impl Statics {
             s.crank_bearing_force.reserve(nc);
             s.eccentric_bearing_force.reserve(nc * nd);
         }
-        // Pins.
         for (k, d) in m.discs.iter().enumerate() {
             let dk = self.disc_index(k);
             let o = [x[dk], x[dk + 1]];
@@ -825,7 +824,8 @@ impl Statics {
                 let rot = rbs * (x[SUN] - thc) + rbp * (alpha - thc);
                 let half = 0.5 * mm.backlash;
                 let idx = [SUN, CARRIER, ci + 2, ci, ci + 1];
-                // Mesh position along the line of action (the dynamic models' `s`).
+                // `s_i` as in the dynamic models (docs/model.md, "The ISO mesh in the dynamic
+                // models"), so the LTCA meets the same stiffness wave at the same pose.
                 let s_mesh = rbs * (x[SUN] - thc) + mm.phases[i] * mm.base_pitch;
                 let mut f_report = 0.0;
                 let mut e_drive = 0.0;
@@ -1015,7 +1015,8 @@ impl Statics {
         };
         match self.kind {
             Kind::Rigid => {
-                // th_c: carrier, disc angles, crank seats.
+                // dx/dth_c of the rigid-joint map: the carrier and every disc angle turn one
+                // for one, each crank seat moves along z x s_i.
                 let col = &mut work.jac[0];
                 col.push((CARRIER, 1.0));
                 for k in 0..m.discs.len() {

@@ -356,7 +356,6 @@ impl RigidModel {
                 out.dissipation += (f - lf.elastic) * pen_rate;
                 out.potential += lf.energy;
                 let point = [o[0] + pc.arm[0], o[1] + pc.arm[1]];
-                // Moment of the pin's force (-f n) on the disc about the disc centre.
                 sink.pin(k, j, f, pen, -f * lever_c, point, n);
             }
         }
@@ -364,7 +363,8 @@ impl RigidModel {
             let delta = m.sun_base_radius * (x[SUN] - x[CARRIER])
                 + m.planet_base_radius * (x[CRANK] - x[CARRIER]);
             let rate = m.sun_base_radius * (v[SUN] - vc) + m.planet_base_radius * (va - vc);
-            // Mesh position along the line of action (sun relative to the carrier).
+            // The part of `s_i = r_bs (th_s - th_c) + gamma_i p_b` shared by all planets
+            // (docs/model.md, "The ISO mesh in the dynamic models").
             let s0 = m.sun_base_radius * (x[SUN] - x[CARRIER]);
             let half = 0.5 * m.backlash;
             // Drive flank (delta > half) or coast flank (delta < -half): the same base
