@@ -15,10 +15,10 @@
 //! rigid rated scene at one loaded state (after 0.05 s from rest); `phys N`: N force evaluations of
 //! the physical rated preset (compliant roller bearings) at one loaded state (after 0.1 s from
 //! rest).
-use rvdyn::dynamics::model::compliant::CompliantModel;
 use rvdyn::dynamics::model::ReducerModel;
-use rvdyn::dynamics::run::recorder::Channel;
+use rvdyn::dynamics::model::compliant::CompliantModel;
 use rvdyn::dynamics::model::rigid_system::RigidSystem;
+use rvdyn::dynamics::run::recorder::Channel;
 use rvdyn::dynamics::{RigidModel, RunControl, Scene, SimOptions, simulate};
 use rvdyn::solve::generalized_alpha::GeneralizedAlpha;
 use rvdyn::solve::{MechanicalSystem, Method, State};

@@ -9,8 +9,8 @@
 
 use rvdyn::analysis::pin_load_sharing::line_law_load_sharing;
 use rvdyn::contact::Material;
-use rvdyn::dynamics::model::compliant::CompliantModel;
 use rvdyn::dynamics::model::ReducerModel;
+use rvdyn::dynamics::model::compliant::CompliantModel;
 use rvdyn::dynamics::scene::{
     Drive, Initial, Joints, Load, PAPER_INPUT_SPEED, PHYSICAL_DAMPING_RATIO,
     PHYSICAL_REFERENCE_FREQUENCY, StartKind,

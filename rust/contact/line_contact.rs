@@ -680,10 +680,10 @@ pub(crate) fn profile_curvature_checked(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_util::close;
     use crate::contact::hertz::{hertz_line_contact, palmgren_approach};
     use crate::geometry::CycloidGeometry;
     use crate::geometry::cycloid::CycloidParams;
+    use crate::test_util::close;
 
     const STEEL: Material = Material {
         youngs_modulus: 2.17e11,

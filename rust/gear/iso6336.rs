@@ -407,8 +407,8 @@ pub fn planet_mesh_phases(z_sun: u32, planet_angles: &[f64]) -> Result<Vec<f64>>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_util::close;
     use crate::geometry::involute::InvoluteStage;
+    use crate::test_util::close;
 
     fn paper_pair() -> IsoGearPair {
         IsoGearPair::spur(18, 42, 3e-3, 20f64.to_radians(), 0.030)

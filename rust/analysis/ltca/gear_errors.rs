@@ -115,8 +115,8 @@ mod tests {
     use crate::analysis::ltca::statics::{ContactState, Family, Kind, Statics, Work};
     use crate::dynamics::model::compliant::CompliantModel;
     use crate::dynamics::model::rigid::RigidModel;
-    use crate::dynamics::scene::{Drive, GearError, Joints};
     use crate::dynamics::run::sink::NoSink;
+    use crate::dynamics::scene::{Drive, GearError, Joints};
     use crate::solve::MechanicalSystem;
 
     /// Runout and pitch errors of 3-10 um on the sun and every planet (sinusoid and table).

@@ -1409,8 +1409,8 @@ fn add_bearing(
 mod tests {
     use super::*;
     use crate::dynamics::model::compliant::CompliantModel;
-    use crate::dynamics::scene::Scene;
     use crate::dynamics::run::sink::NoSink;
+    use crate::dynamics::scene::Scene;
     use crate::solve::MechanicalSystem;
 
     fn rng(seed: u64) -> impl FnMut() -> f64 {
