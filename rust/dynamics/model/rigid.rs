@@ -3,8 +3,8 @@
 //! Coordinates `x = [th_c, alpha, th_s]`: carrier angle, absolute crank angle (all cranks equal
 //! when the joints are ideal), sun angle. Disc `k` (eccentric phase `a_k`) has its centre at
 //! `O_k = e (cos(alpha + a_k), sin(alpha + a_k))` and turns with the carrier,
-//! `theta_k = th_c - a_k / zc` (the half-lobe offset of the second disc). The mass matrix is
-//! diagonal and constant in these coordinates:
+//! `theta_k = th_c + delta_k`, `delta_k = -a_k / zc` (the half-lobe offset of the second disc).
+//! The mass matrix is diagonal and constant in these coordinates:
 //! `M_cc = J_c + J_load + n_cr m_cr r_cr^2 + sum J_d`, `M_aa = n_cr J_cr + sum m_d e^2`,
 //! `M_ss = J_s`. Generalised forces come from virtual work: a pin force `-F N` at the profile
 //! point `X` of disc `k` gives `Q_c = -F N.(z x (X - O_k))`, `Q_a = -F N.(z x O_k)`; a mesh
