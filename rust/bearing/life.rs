@@ -38,6 +38,8 @@
 //! `d_m` pitch diameter in mm) and the load part `M1 = f1 F d_m` (`F` radial load in N).
 //! `f0` and `f1` depend on the bearing type and lubrication (for cylindrical and needle roller
 //! bearings `f1` is about 2e-4 to 4e-4 and `f0` a few units; they are inputs here).
+//!
+//! Theory: docs/model.md, section "Load rating, life and friction torque".
 
 use crate::error::{Result, RvdynError, require_non_negative, require_positive};
 

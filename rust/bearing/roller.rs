@@ -24,6 +24,9 @@
 //! (Harris & Kotzalas, ch. 7, tabulate `J_r(epsilon)` for line contact: 0.2453, computed with
 //! the exponent rounded to 1.1), hence the radial
 //! stiffness `dF_r / d delta_r = (10/9) F_r / delta_r`.
+//!
+//! Theory: docs/model.md, sections "Roller bearing with clearance"
+//! and "Roller bearings in the compliant model".
 
 use crate::error::{Result, RvdynError, require_non_negative, require_positive};
 use std::f64::consts::PI;

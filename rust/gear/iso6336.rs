@@ -29,6 +29,9 @@
 //! a chosen width centred on each zone boundary; the ramp is antisymmetric about the boundary,
 //! so the mean is unchanged. For `eps >= 2` the wave alternates between `n` and `n + 1`
 //! pairs of stiffness `c_gamma / eps` each.
+//!
+//! Theory: docs/model.md, sections "ISO 6336-1 method B"
+//! and "Time variation along the line of action".
 
 use crate::error::{Result, RvdynError, require_finite, require_non_negative, require_positive};
 use std::f64::consts::PI;

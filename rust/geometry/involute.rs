@@ -10,6 +10,8 @@
 //! cranks must then be phased alike for the eccentrics; that is a crank matter, not a gear
 //! one.) What can fail is spacing (neighbouring planets' tip circles overlap) and continuity
 //! of mesh (contact ratio below 1); both are checked.
+//!
+//! Theory: docs/model.md, section "Geometry" of "First-stage mesh".
 
 use crate::error::{Result, RvdynError, num, require_non_negative};
 use crate::geometry::cycloid::require_length;

@@ -5,6 +5,8 @@
 //! `atol + rtol |v_i| L_i tau` with `tau = 1 ms`, so that `atol` bounds both the displacement
 //! error and the displacement a velocity error makes within a millisecond. No relative
 //! tolerance on positions: absolute angles grow without bound and say nothing about accuracy.
+//!
+//! Theory: docs/model.md, section "Dormand-Prince 5(4)".
 
 use crate::error::{Result, RvdynError};
 use crate::solve::integrator::{Integrator, IntegratorEntry, Settings, Stats};

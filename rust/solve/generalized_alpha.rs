@@ -24,6 +24,9 @@
 //! Newton converges fast (re-assembled without new force evaluations when only the step
 //! changes); a step whose Newton stalls is retried with a fresh Jacobian and then
 //! split in halves (down to 1/1024 of the step) before the run is declared failed.
+//!
+//! Theory: docs/model.md, sections "Generalized-alpha (Arnold & Bruls form) with Newton"
+//! and "Newton tolerance of generalized-alpha".
 
 use crate::error::{Result, RvdynError};
 use crate::solve::integrator::{FixedClock, Integrator, IntegratorEntry, Settings, Stats};
