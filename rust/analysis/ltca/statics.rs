@@ -2,9 +2,9 @@
 //!
 //! Everything is evaluated in the full coordinates of the compliant-joint model
 //! (`x = [th_c, th_s, (x_i, y_i, alpha_i) per crank, (X_k, Y_k, theta_k) per disc]`, see
-//! `dynamics::model::compliant`), at zero velocity: `Q(x)` and `K(x) = -dQ/dx`. The rigid-joint model
-//! and the compliant model with rigid crank bearings are maps `x = x(q)` from fewer unknowns
-//! `q`; their forces and stiffness follow by the chain rule
+//! `dynamics::model::compliant`), at zero velocity: `Q(x)` and `K(x) = -dQ/dx`. The
+//! rigid-joint model and the compliant model with rigid crank bearings are maps `x = x(q)` from
+//! fewer unknowns `q`; their forces and stiffness follow by the chain rule
 //! `Q_q = J^T Q_x`, `K_q = J^T K_x J - sum_r Q_x,r hess(x_r)` (`J = dx/dq`).
 //!
 //! Every coupling is a scalar or vector deflection of the coordinates with its gradient and
