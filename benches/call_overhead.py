@@ -7,7 +7,7 @@ two builds, run this script alternately under each (A B A B ...) and compare the
     for i in 1 2 3; do PYTHONPATH=build_a python benches/call_overhead.py; \
                        PYTHONPATH=build_b python benches/call_overhead.py; done
 
-BENCHMARKS.md section 9 has the numbers of issue 7 (before and after the compiled scene).
+BENCHMARKS.md section 9 has the numbers before and after the compiled scene.
 """
 
 from __future__ import annotations

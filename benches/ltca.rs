@@ -4,7 +4,7 @@
 //! meshes, roller bearings with clearance) at rated torque (`ltca_physical/...`).
 use criterion::{Criterion, criterion_group, criterion_main};
 use rvdyn::analysis::ltca::Ltca;
-use rvdyn::dynamics::compliant::default_joints;
+use rvdyn::dynamics::model::compliant::default_joints;
 use rvdyn::dynamics::scene::{ContactLawSpec, Scene};
 use std::hint::black_box;
 
@@ -30,7 +30,7 @@ fn bench_ltca(c: &mut Criterion) {
     });
 }
 
-/// The workload issue 9 names with the physical preset's pin law: two discs of 24 pins, the
+/// The paper's scene with the physical preset's pin law: two discs of 24 pins, the
 /// line-contact (Johnson) law with its location term, linear compliant bearings, the paper's
 /// constant mesh stiffness. It separates what the physical preset's roller bearings with
 /// clearance and ISO meshes cost from what its pin law costs.

@@ -5,7 +5,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use rvdyn::analysis::modal::{Linearizer, campbell, modal_analysis, modes_at};
 use rvdyn::dynamics::Scene;
-use rvdyn::dynamics::compliant::default_joints;
+use rvdyn::dynamics::model::compliant::default_joints;
 use std::hint::black_box;
 
 const RATED: f64 = 43_921.260_376_02;

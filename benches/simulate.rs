@@ -2,7 +2,7 @@
 //! 0.1 s of the default scene at full load.
 use criterion::{Criterion, criterion_group, criterion_main};
 use rvdyn::dynamics::model::ReducerModel;
-use rvdyn::dynamics::system::RigidSystem;
+use rvdyn::dynamics::model::rigid_system::RigidSystem;
 use rvdyn::dynamics::{RigidModel, RunControl, Scene, SimOptions, simulate};
 use rvdyn::solve::dopri5::Dopri5;
 use rvdyn::solve::generalized_alpha::GeneralizedAlpha;

@@ -1,9 +1,8 @@
-"""Sobol sensitivity of the physical preset's transmission error (issue 11's ranking of the
-tolerances that matter): `Scene.physical("rated")`, the same tolerances as
-`benches/study_physical.py` (the two profile modifications, normal, band +-10 um = 6 sigma, and
-the 24 pin radii, uniform +-5 um), first-order and total Sobol indices of the forward TE
-peak-to-peak from a Saltelli design (`rvdyn.study.sobol`, SciPy's `sobol_indices`) with
-bootstrap confidence intervals.
+"""Sobol sensitivity of the physical preset's transmission error (which tolerances matter):
+`Scene.physical("rated")`, the same tolerances as `benches/study_physical.py` (the two profile
+modifications, normal, band +-10 um = 6 sigma, and the 24 pin radii, uniform +-5 um),
+first-order and total Sobol indices of the forward TE peak-to-peak from a Saltelli design
+(`rvdyn.study.sobol`, SciPy's `sobol_indices`) with bootstrap confidence intervals.
 
     python benches/sobol_physical.py                   # n = 512 base samples: 14 336 analyses
     python benches/sobol_physical.py --n 64 --points 24  # a quick look

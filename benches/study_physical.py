@@ -1,6 +1,6 @@
-"""The tolerance study of the physical preset (issue 11's closing figure): `Scene.physical("rated")`,
-the "ltca" kernel, Monte Carlo seed 11 over the two profile modifications (normal, band +-10 um
-= 6 sigma) and the 24 pin radii (uniform +-5 um), rows streamed to Parquet, on 2 workers.
+"""The tolerance study of the physical preset: `Scene.physical("rated")`, the "ltca" kernel,
+Monte Carlo seed 11 over the two profile modifications (normal, band +-10 um = 6 sigma) and the
+24 pin radii (uniform +-5 um), rows streamed to Parquet, on 2 workers.
 
     python benches/study_physical.py                      # 10 000 samples, processes:2
     python benches/study_physical.py --runner dask --samples 10000

@@ -15,10 +15,10 @@
 //! rigid rated scene at one loaded state (after 0.05 s from rest); `phys N`: N force evaluations of
 //! the physical rated preset (compliant roller bearings) at one loaded state (after 0.1 s from
 //! rest).
-use rvdyn::dynamics::compliant::CompliantModel;
 use rvdyn::dynamics::model::ReducerModel;
-use rvdyn::dynamics::record::Channel;
-use rvdyn::dynamics::system::RigidSystem;
+use rvdyn::dynamics::model::compliant::CompliantModel;
+use rvdyn::dynamics::model::rigid_system::RigidSystem;
+use rvdyn::dynamics::run::recorder::Channel;
 use rvdyn::dynamics::{RigidModel, RunControl, Scene, SimOptions, simulate};
 use rvdyn::solve::generalized_alpha::GeneralizedAlpha;
 use rvdyn::solve::{MechanicalSystem, Method, State};
@@ -70,7 +70,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         scene = Scene::physical("rated")?;
     }
     if arg(4, "rigid") == "compliant" {
-        scene.joints = rvdyn::dynamics::compliant::default_joints();
+        scene.joints = rvdyn::dynamics::model::compliant::default_joints();
     }
     let mut opt = SimOptions::new(t_end, method);
     if let (Ok(atol), Ok(rtol)) = (arg(6, "").parse::<f64>(), arg(7, "").parse::<f64>()) {

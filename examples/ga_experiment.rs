@@ -21,8 +21,8 @@
 //! for every dt used, so no interpolation is involved), over the peak pin force.
 use nalgebra::{DMatrix, DVector};
 use rvdyn::dynamics::model::ReducerModel;
-use rvdyn::dynamics::sink::ContactSink;
-use rvdyn::dynamics::system::RigidSystem;
+use rvdyn::dynamics::model::rigid_system::RigidSystem;
+use rvdyn::dynamics::run::sink::ContactSink;
 use rvdyn::dynamics::{RigidModel, Scene};
 use rvdyn::solve::dopri5::Dopri5;
 use rvdyn::solve::generalized_alpha::GeneralizedAlpha;

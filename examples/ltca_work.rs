@@ -22,7 +22,7 @@
 //! `NewtonOptions::regularise_singular` from the first attempt; `LTCA_WORK_PERIODS` the mesh
 //! periods of `bare` (more than one: 336 angles per period, as `transmission_error`'s window).
 use rvdyn::analysis::ltca::Ltca;
-use rvdyn::dynamics::compliant::default_joints;
+use rvdyn::dynamics::model::compliant::default_joints;
 use rvdyn::dynamics::scene::{ContactLawSpec, Scene};
 use std::hint::black_box;
 

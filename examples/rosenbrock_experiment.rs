@@ -31,7 +31,7 @@
 //! state), each Jacobian `1 + 2n`.
 
 use nalgebra::{DMatrix, DVector};
-use rvdyn::dynamics::record::Channel;
+use rvdyn::dynamics::run::recorder::Channel;
 use rvdyn::dynamics::{RunControl, Scene, SimOptions, simulate};
 use rvdyn::error::{Result, RvdynError};
 use rvdyn::solve::dopri5::VELOCITY_ERROR_TIME;

@@ -1,7 +1,7 @@
 //! The speed goal of BENCHMARKS.md: 5 s simulated of the rated default scene at the setting the
 //! work-precision benchmark found for a pin-force error <= 0.1 % of the peak. Used for
 //! profiling: `valgrind --tool=callgrind target/release/examples/speed_goal`.
-use rvdyn::dynamics::record::Channel;
+use rvdyn::dynamics::run::recorder::Channel;
 use rvdyn::dynamics::{RunControl, Scene, SimOptions, simulate};
 use rvdyn::solve::Method;
 

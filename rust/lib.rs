@@ -26,6 +26,9 @@ pub mod geometry;
 pub mod kinematics;
 pub mod solve;
 
+#[cfg(test)]
+pub(crate) mod test_util;
+
 #[cfg(feature = "python")]
 mod python;
 

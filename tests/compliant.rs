@@ -1,7 +1,7 @@
 //! Integration tests of the compliant-joint model through the public driver `simulate`.
 
-use rvdyn::dynamics::compliant::default_joints;
-use rvdyn::dynamics::record::Recording;
+use rvdyn::dynamics::model::compliant::default_joints;
+use rvdyn::dynamics::run::recorder::Recording;
 use rvdyn::dynamics::scene::{Initial, Joints};
 use rvdyn::dynamics::{RunControl, Scene, SimOptions, simulate};
 use rvdyn::solve::Method;
@@ -40,7 +40,7 @@ fn peak_pin_force(r: &Recording) -> f64 {
 /// 2 discs, 24 pins, 3 meshes), finite values, and three independent crank rotations.
 #[test]
 fn simulate_compliant_records_all_channels() {
-    use rvdyn::dynamics::record::Channel;
+    use rvdyn::dynamics::run::recorder::Channel;
     let s = scene("paper", default_joints(), Initial::Steady);
     let mut opt = SimOptions::new(2e-3, Method::GeneralizedAlpha);
     opt.dt = Some(2e-5);

@@ -9,8 +9,8 @@
 
 use rvdyn::analysis::pin_load_sharing::line_law_load_sharing;
 use rvdyn::contact::Material;
-use rvdyn::dynamics::compliant::CompliantModel;
 use rvdyn::dynamics::model::ReducerModel;
+use rvdyn::dynamics::model::compliant::CompliantModel;
 use rvdyn::dynamics::scene::{
     Drive, Initial, Joints, Load, PAPER_INPUT_SPEED, PHYSICAL_DAMPING_RATIO,
     PHYSICAL_REFERENCE_FREQUENCY, StartKind,
@@ -174,7 +174,7 @@ fn main_torsional_mode_has_the_damping_ratio_the_preset_sets() {
     let mut p = Scene::paper("rated").unwrap();
     p.initial = Initial::Steady;
     let pm = rvdyn::dynamics::RigidModel::new(&p).unwrap();
-    let sys = rvdyn::dynamics::system::RigidSystem::new(&pm);
+    let sys = rvdyn::dynamics::model::rigid_system::RigidSystem::new(&pm);
     let (q, v) = sys.initial_state();
     let mut st = State::new(&sys, 0.0, q, v).unwrap();
     let mut ga = GeneralizedAlpha::new(0.8, 1e-10, false).unwrap();
@@ -393,7 +393,7 @@ fn equal_eccentricity_error_shifts_the_disc_path_radius_by_that_error() {
     // the bearings is the same with and without the error, so the path radius moves by
     // exactly the error (to the dynamic ripple: 1 % of 10 um).
     let mut s = Scene::paper("idle").unwrap();
-    s.joints = rvdyn::dynamics::compliant::default_joints();
+    s.joints = rvdyn::dynamics::model::compliant::default_joints();
     s.cycloid.d_rrp = 20e-6;
     s.cycloid.d_rp = -20e-6;
     s.initial = Initial::Steady;
@@ -422,7 +422,7 @@ fn equal_hole_error_moves_the_disc_by_that_error() {
     // minus that error turned by the disc angle, and leaves disc 1 where it was (1 % of 10 um;
     // modified profile so that no pin holds the disc at idle).
     let mut s = Scene::paper("idle").unwrap();
-    s.joints = rvdyn::dynamics::compliant::default_joints();
+    s.joints = rvdyn::dynamics::model::compliant::default_joints();
     s.cycloid.d_rrp = 20e-6;
     s.cycloid.d_rp = -20e-6;
     s.initial = Initial::Steady;

@@ -1,4 +1,4 @@
-"""Machine shafts (issue 8 item 5): output shaft to the load inertia, drive shaft from the motor.
+"""Machine shafts: output shaft to the load inertia, drive shaft from the motor.
 
 Closed forms: docs/model.md#machine-shafts. Every run is the paper preset at rated load (the
 reducer's own compliance is about 3e7 N m/rad at the output, so the shafts below are the soft

@@ -1,5 +1,5 @@
-"""Disc profile error and first-stage gear errors (issue 8 item 7), each against a first-order
-analytic effect (docs/model.md#manufacturing-errors-of-profile-and-gears)."""
+"""Disc profile error and first-stage gear errors, each against a first-order analytic effect
+(docs/model.md#manufacturing-errors-of-profile-and-gears)."""
 
 import math
 

@@ -33,7 +33,7 @@ def test_rigid_reactions_are_the_limit_of_stiff_equal_bearings() -> None:
         errors.append(float(np.abs(a - b).max()) / peak)
     assert errors[1] < 2e-3, errors
     assert errors[0] > 5 * errors[1], errors
-    # The reactions are far above the pin forces (about 4x the peak pin force, issue 8).
+    # The reactions are far above the pin forces (about 4x the peak pin force).
     assert np.linalg.norm(a, axis=-1).max() > 3 * rigid.pin_force[w].max()
 
 

@@ -1,4 +1,4 @@
-"""Bad arguments to the plotting helpers end in the rvdyn hierarchy (issue 12, D9 and D16)."""
+"""Bad arguments to the plotting helpers end in the rvdyn hierarchy."""
 
 from __future__ import annotations
 
@@ -12,13 +12,13 @@ from rvdyn import plotting
 
 
 @pytest.mark.parametrize("pins", [[0], [25], [-1], [float("nan")], [1.5], [True], ["3"], [2**70]])
-def test_d16_pin_numbers_outside_1_to_zp_are_rejected(pins):
+def test_pin_numbers_outside_1_to_zp_are_rejected(pins):
     # Pin 0 used to select pin 24 (index -1) under the label "pin 0".
     with pytest.raises(rvdyn.ParameterError, match="pin number"):
         plotting.pin_indices(pins, 24)
 
 
-def test_d16_pin_numbers_map_to_indices():
+def test_pin_numbers_map_to_indices():
     assert plotting.pin_indices([1, 24, np.int64(3)], 24) == [0, 23, 2]
     assert plotting.pin_indices(range(1, 4), 3) == [0, 1, 2]
     with pytest.raises(rvdyn.ParameterError, match="iterable"):

@@ -1,6 +1,5 @@
-"""Regression tests of issue 7 (the house) and of issue 12's D2, D10, D11, D12, D17: the
-compiled Scene, the Options object, the channel registry, sweep results, and the robustness
-details (Ctrl-C in sweeps, dopri5 on a stiff scene)."""
+"""The compiled Scene, the Options object, the channel registry, sweep results, and the
+robustness details (Ctrl-C in sweeps, dopri5 on a stiff scene)."""
 
 from __future__ import annotations
 
@@ -27,7 +26,7 @@ RESTORE_SIGINT = "import signal; signal.signal(signal.SIGINT, signal.default_int
 
 # ------------------------------------------------------------------------------ Scene
 def test_paper_takes_the_load_case_by_keyword() -> None:
-    # D10: Scene.paper(load="rated") became a dotted-path change and failed later.
+    # load= is the load case, not a dotted-path change that would fail later.
     assert Scene.paper(load="rated") == Scene.paper("rated")
     assert Scene.paper(load="idle")["load"] == {"kind": "idle"}
     with pytest.raises(rvdyn.SceneError, match="idle"):
@@ -44,7 +43,7 @@ def test_paper_takes_the_load_case_by_keyword() -> None:
     {"drive.spede": 1.0},
 ])
 def test_unknown_fields_are_rejected_everywhere(changes: dict[str, object]) -> None:
-    # D11: unit variants of tagged enums and inertias.* dropped unknown fields silently.
+    # Unknown fields are errors also in unit variants of tagged enums and in inertias.*.
     with pytest.raises(rvdyn.SceneError, match="unknown"):
         Scene.paper("idle").replace(**changes)
     data = Scene.paper("idle").to_dict()
@@ -54,7 +53,7 @@ def test_unknown_fields_are_rejected_everywhere(changes: dict[str, object]) -> N
 
 
 def test_equal_scenes_hash_equal() -> None:
-    # D12: 0.0 and -0.0 compare equal, so they must hash equal.
+    # 0.0 and -0.0 compare equal, so they must hash equal.
     a = Scene.paper("rated", **{"cycloid.d_delta": 0.0})
     b = Scene.paper("rated", **{"cycloid.d_delta": -0.0})
     assert a == b and hash(a) == hash(b) and len({a, b}) == 1
@@ -140,7 +139,7 @@ def test_channels_come_from_the_core_registry() -> None:
 
 # ------------------------------------------------------------------------------ sweep
 def test_sweep_checks_options_once_and_raises_like_simulate() -> None:
-    # D17: bad options came back as one ParameterError per run.
+    # Bad options raise once, before any run, not as one ParameterError per run.
     s = Scene.paper("idle")
     for kwargs in ({"t_end": float("nan")}, {"t_end": 1e-3, "dt": -1.0}, {"t_end": 1e-3, "max_samples": 1}):
         t_end = kwargs.pop("t_end")
@@ -177,8 +176,9 @@ def _interrupt(code: str, wait_for_ready: bool = True) -> tuple[float, str, int]
 
 
 def test_ctrl_c_stops_a_sweep() -> None:
-    # D2: sweep ignored Ctrl-C until every run finished, then raised PanicException. The
-    # interval is not asserted (no timed assertions); a hang fails through the timeout.
+    # Ctrl-C stops the runs of a sweep and raises KeyboardInterrupt, not PanicException after
+    # every run has finished. The interval is not asserted (no timed assertions); a hang fails
+    # through the timeout.
     code = ("import rvdyn\ns = rvdyn.Scene.paper('rated')\nprint('ready', flush=True)\n"
             "rvdyn.sweep([s, s], 600.0, threads=2, channels=['motion'], max_samples=1000)\n")
     _, err, rc = _interrupt(code)
@@ -195,8 +195,8 @@ def test_ctrl_c_stops_a_run_with_sigint_restored() -> None:
 
 # ------------------------------------------------------------------------------ dopri5
 def test_dopri5_stops_with_advice_on_a_stiff_scene() -> None:
-    # Issue 7 defect 3: very light disc on 1e9 N/m eccentric bearings, crank bearings rigid:
-    # dopri5's steps fell to ~2e-8 s without an error (a 5 ms run took minutes).
+    # Very light disc on 1e9 N/m eccentric bearings, crank bearings rigid: dopri5's steps fall
+    # to ~2e-8 s, so it must stop with advice instead of running for minutes.
     s = Scene.paper("paper").replace(**{
         "inertias": {"sun": {"mass": 41.6, "inertia": 1.0}, "crank": {"mass": 0.01, "inertia": 0.594},
                      "disc": {"mass": 1.0, "inertia": 1.29e-05}, "carrier": {"mass": 1.54, "inertia": 1.0},
@@ -212,8 +212,8 @@ def test_dopri5_stops_with_advice_on_a_stiff_scene() -> None:
 
 
 def test_work_and_memory_are_bounded() -> None:
-    # Issue 12 D3/D4/D14 (the simulate part): a sample count that overflowed returned an empty
-    # Result, dt = 1e-300 ran forever, a huge max_samples could abort on allocation.
+    # A sample count that overflows, dt = 1e-300 and a huge max_samples are errors before any
+    # work: not an empty Result, an endless run or an allocation abort.
     s = Scene.paper("rated")
     with pytest.raises(rvdyn.ParameterError, match="steps"):
         simulate(s, 0.01, dt=1e-300)
@@ -280,7 +280,7 @@ def test_analysis_counts_are_bounded_and_whole() -> None:
 
 
 def test_damaged_result_files_raise_parameter_error(tmp_path: Path) -> None:
-    # Issue 12 D9 (the Result.load part): KeyError, JSONDecodeError, BadZipFile, EOFError...
+    # Damaged files raise ParameterError, not KeyError, JSONDecodeError, BadZipFile, EOFError...
     good = simulate(Scene.paper("rated"), 1e-3, channels="motion").save(tmp_path / "good.npz")
     cases = {
         "missing.npz": None,

@@ -1,4 +1,4 @@
-"""The physical preset through the Python API (issue 8): preset, channels, efficiency, bearing life."""
+"""The physical preset through the Python API: preset, channels, efficiency, bearing life."""
 
 import math
 from typing import Any

@@ -55,9 +55,9 @@ CASES = [
     Case("default, step start from rest", {}, 0.5),
     # Far softer contacts at the rated 35 kN pin load mean approaches beyond the physical bound
     # (a tenth of the pin radius): the run must stop with advice to raise the stiffness. At
-    # x0.1 the approach stays below it (0.88 mm); that run used to stop with a false "exact gap
-    # not found" once unloaded pins sat beyond the root's 0.72 mm centre of curvature (issue 12
-    # D5). At lower loads the same laws run.
+    # x0.1 the approach stays below it (0.88 mm), and the run must finish although unloaded pins
+    # sit beyond the root's 0.72 mm centre of curvature (two local minima of the distance; the
+    # gap is the smaller). At lower loads the same laws run.
     Case("contact stiffness x0.01, rated load", {"contact.pin": law(K * 0.01), "contact.mesh": law(K * 0.01)},
          0.5, expect="error", advice="too soft"),
     Case("contact stiffness x0.1, rated load", {"contact.pin": law(K * 0.1), "contact.mesh": law(K * 0.1)},

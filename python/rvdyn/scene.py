@@ -89,7 +89,7 @@ class Scene:
         True
         """
         if "load" in changes and not isinstance(changes["load"], dict):
-            # Scene.paper(load="rated"): the load case given by keyword (issue 12, D10).
+            # Scene.paper(load="rated"): the load case given by keyword, not a field change.
             if load != "paper":
                 raise SceneError(
                     "give the load case once: Scene.paper('rated') or Scene.paper(load='rated')"

@@ -211,7 +211,7 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
              "step_check": step_check, "h_min": h_min, "max_steps": max_steps}
     t = _t_end(t_end)
     # Each scene gets the defaults simulate would give it: scenes with and without roller
-    # bearings run as two groups (one group's defaults used to apply to every scene).
+    # bearings run as two groups, each with its own defaults.
     groups: dict[bool, list[int]] = {}
     for i, s in enumerate(scene_list):
         groups.setdefault(_has_rollers(s), []).append(i)

@@ -38,6 +38,8 @@
 //! **Total.** `P_in = P_out (1 + L_pin) + mu_mesh H_V (1 - 1/i) P_in`, so
 //! `eta = (1 - mu_mesh H_V (1 - 1/i)) / (1 + L_pin)`. Bearing friction (Palmgren torques,
 //! [`crate::bearing::PalmgrenFriction`]) adds `sum M_k |w_k| / P_out` to `L_pin` when known.
+//!
+//! Theory: docs/model.md, section "Analytic efficiency estimate".
 
 use crate::error::{Result, RvdynError, require_finite};
 use crate::geometry::CycloidGeometry;
@@ -217,10 +219,7 @@ pub fn rv_efficiency(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     #[test]
     fn pin_loss_closed_form_by_hand() {

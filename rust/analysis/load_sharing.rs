@@ -6,6 +6,8 @@
 //! the lever of the contact normal about the disc centre, `phi_j` the pin's mesh angle from the
 //! eccentricity direction, `rc' = e zc` and `S = sqrt(1 + K1^2 - 2 K1 cos phi)`. The pins on the
 //! loaded half (`l_j > 0`) carry `F_j = T_c l_j / sum(l^2)`, so that `sum F_j l_j = T_c`.
+//!
+//! Theory: docs/model.md, section "Lever arms and the classical load sharing".
 
 use crate::error::{Result, RvdynError, require_finite};
 use crate::geometry::CycloidGeometry;

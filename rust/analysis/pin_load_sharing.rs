@@ -18,6 +18,8 @@
 //! (`phi = (z_sun / z_planet) th_c` for the crank angle relative to the carrier), and the
 //! disc turns with the carrier, so `beta = th_c (zp + z_sun / z_planet) / zc`: see
 //! [`output_windup`].
+//!
+//! Theory: docs/model.md, section "Quasi-static load sharing with the line law".
 
 use crate::contact::Material;
 use crate::contact::line_contact::LineContactLaw;

@@ -26,7 +26,7 @@
 //!
 //! Basic static radial load rating of a radial roller bearing (ISO 76:2006, *Rolling bearings -
 //! Static load ratings*): `C0r = 44 (1 - D_we cos alpha / D_pw) i Z L_we D_we cos alpha` [N,
-//! with lengths in mm], the load at which the most loaded roller's contact reaches 4000 MPa and a
+//! with lengths in mm], the load at which the most loaded roller's contact reaches `4000 MPa` and a
 //! permanent deformation of about 1e-4 of the roller diameter. The static safety factor
 //! `s0 = C0r / P0` (`P0` the peak radial load) should be at least 1 (ISO 76 gives 1-3 by
 //! application); below it the raceways yield and an elastic roller law no longer holds.
@@ -38,6 +38,8 @@
 //! `d_m` pitch diameter in mm) and the load part `M1 = f1 F d_m` (`F` radial load in N).
 //! `f0` and `f1` depend on the bearing type and lubrication (for cylindrical and needle roller
 //! bearings `f1` is about 2e-4 to 4e-4 and `f0` a few units; they are inputs here).
+//!
+//! Theory: docs/model.md, section "Load rating, life and friction torque".
 
 use crate::error::{Result, RvdynError, require_non_negative, require_positive};
 
@@ -279,10 +281,7 @@ impl PalmgrenFriction {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     #[test]
     fn fc_by_hand() {

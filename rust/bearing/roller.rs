@@ -24,6 +24,9 @@
 //! (Harris & Kotzalas, ch. 7, tabulate `J_r(epsilon)` for line contact: 0.2453, computed with
 //! the exponent rounded to 1.1), hence the radial
 //! stiffness `dF_r / d delta_r = (10/9) F_r / delta_r`.
+//!
+//! Theory: docs/model.md, sections "Roller bearing with clearance"
+//! and "Roller bearings in the compliant model".
 
 use crate::error::{Result, RvdynError, require_non_negative, require_positive};
 use std::f64::consts::PI;
@@ -123,11 +126,6 @@ impl RollerBearing {
     /// Radial clearance per side \[m\].
     pub fn clearance(&self) -> f64 {
         self.clearance
-    }
-
-    /// Roller constant `K_n` [N/m^(10/9)]: `Q = K_n delta^(10/9)`.
-    pub fn roller_constant(&self) -> f64 {
-        self.k_si
     }
 
     /// Load `Q` \[N\] and slope `dQ/d delta` [N/m] of one roller compressed by `delta` \[m\]
@@ -299,10 +297,7 @@ pub const RADIAL_INTEGRAL_HALF: f64 = 0.244_798_558_710;
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     #[test]
     fn radial_integral_by_quadrature() {

@@ -32,6 +32,9 @@
 //! The force is continuous at `delta = 0` (it carries the factor `F_el(0) = 0`) and is clamped
 //! at 0 so that a fast-separating contact never pulls. With the exact factor and `e > 0`,
 //! `1 - chi e > 0`, so during a single impact the clamp is never active.
+//!
+//! Theory: docs/model.md, sections "Damping from a coefficient of restitution"
+//! and "Stiffness-proportional damping".
 
 use crate::error::{Result, RvdynError, require_positive};
 use serde::{Deserialize, Serialize};

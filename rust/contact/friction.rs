@@ -19,6 +19,9 @@
 //! Stribeck curve). Without it `mu = mu_c`.
 //!
 //! Friction power dissipated: `P = -F_t v = mu N v tanh(v / v_reg) >= 0`.
+//!
+//! Theory: docs/model.md, sections "Regularised Coulomb friction"
+//! and "Friction in the dynamic models".
 
 use crate::error::{Result, RvdynError, require_positive};
 

@@ -282,10 +282,7 @@ pub fn palmgren_stiffness(force: f64, length: f64) -> Result<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     const STEEL: Material = Material {
         youngs_modulus: 2.17e11,

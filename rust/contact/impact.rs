@@ -55,8 +55,8 @@ impl ImpactLaw {
     /// Build a validated law from stiffness [N/m^exponent], exponent [-], maximum damping
     /// [N s/m] and damping depth \[m\].
     ///
-    /// Errors (`RvdynError::Parameter`) if any value is not finite, stiffness <= 0,
-    /// exponent < 1, max_damping < 0 or damping_depth <= 0.
+    /// Errors (`RvdynError::Parameter`) if any value is not finite, `stiffness <= 0`,
+    /// `exponent < 1`, `max_damping < 0` or `damping_depth <= 0`.
     pub fn new(
         stiffness: f64,
         exponent: f64,
@@ -214,6 +214,7 @@ impl ImpactLaw {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_util::close;
 
     #[test]
     fn elastic_energy_is_the_integral_of_the_elastic_force() {
@@ -227,10 +228,6 @@ mod tests {
         assert!((integral - law.elastic_energy(x)).abs() < 1e-7 * law.elastic_energy(x));
         assert_eq!(law.elastic_energy(-1.0), 0.0);
         assert_eq!(law.elastic_force(0.0), 0.0);
-    }
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
     }
 
     #[test]

@@ -683,10 +683,7 @@ mod tests {
     use crate::contact::hertz::{hertz_line_contact, palmgren_approach};
     use crate::geometry::CycloidGeometry;
     use crate::geometry::cycloid::CycloidParams;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     const STEEL: Material = Material {
         youngs_modulus: 2.17e11,

@@ -26,6 +26,8 @@
 //! A penetration `delta = -g` with a contact force `F(delta) >= 0` acting as `-F N` on the disc
 //! has the generalised force `Q = -F grad(delta) = F grad(g)` and the tangent stiffness
 //! `K = -dQ/dq = F'(delta) grad(g) grad(g)^T - F hess(g)`.
+//!
+//! Theory: docs/model.md, section "Derivatives of the exact gap".
 
 use crate::error::{Result, RvdynError, require_finite};
 use crate::geometry::CycloidGeometry;

@@ -335,10 +335,7 @@ pub fn stiffness_maximum(p: &StiffnessParams, lo: f64, hi: f64) -> Result<(f64, 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     /// 1000^1.5: N/mm^1.5 -> N/m^1.5.
     const PER_MM15: f64 = 31_622.776_601_683_792;

@@ -12,10 +12,6 @@ pub mod model;
 pub mod run;
 pub mod scene;
 
-// Paths kept for code written against the flat layout.
-pub use model::{compliant, drive, pin_contact, rigid, rigid_system as system};
-pub use run::{driver as simulate, recorder as record, sink};
-
 pub use model::rigid::RigidModel;
 pub use run::driver::{RunControl, SimOptions, run, simulate};
 pub use run::recorder::Recording;

@@ -1,7 +1,7 @@
 //! Gear mesh stiffness by ISO 6336-1 method B, and its variation along the line of action.
 //!
 //! ISO 6336-1 (*Calculation of load capacity of spur and helical gears, Part 1*, 2006 and
-//! 2019 editions), tooth stiffness parameters c' and c_gamma, method B:
+//! 2019 editions), tooth stiffness parameters `c'` and `c_gamma`, method B:
 //!
 //! - `q' = C1 + C2/zn1 + C3/zn2 + C4 x1 + C5 x1/zn1 + C6 x2 + C7 x2/zn2 + C8 x1^2 + C9 x2^2`
 //!   [mm um / N] with `C1..C9 = 0.04723, 0.15551, 0.25791, -0.00635, -0.11654, -0.00193,
@@ -29,6 +29,9 @@
 //! a chosen width centred on each zone boundary; the ramp is antisymmetric about the boundary,
 //! so the mean is unchanged. For `eps >= 2` the wave alternates between `n` and `n + 1`
 //! pairs of stiffness `c_gamma / eps` each.
+//!
+//! Theory: docs/model.md, sections "ISO 6336-1 method B"
+//! and "Time variation along the line of action".
 
 use crate::error::{Result, RvdynError, require_finite, require_non_negative, require_positive};
 use std::f64::consts::PI;
@@ -437,10 +440,7 @@ pub fn planet_mesh_phases(z_sun: u32, planet_angles: &[f64]) -> Result<Vec<f64>>
 mod tests {
     use super::*;
     use crate::geometry::involute::InvoluteStage;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     fn paper_pair() -> IsoGearPair {
         IsoGearPair::spur(18, 42, 3e-3, 20f64.to_radians(), 0.030)

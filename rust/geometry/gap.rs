@@ -906,7 +906,7 @@ mod shift_tests {
         }
     }
 
-    /// Issue D5: a disc with a shift modification of -0.3 .. -2 mm at its kinematic pose. Pins
+    /// A disc with a shift modification of -0.3 .. -2 mm at its kinematic pose. Pins
     /// near a root are 0.3 .. 2 mm outside the pin-centre curve, beyond its 0.72 mm concave
     /// radius of curvature for the larger ones: the distance has two local minima, and the gap
     /// is the smaller (against brute force).

@@ -10,6 +10,8 @@
 //! cranks must then be phased alike for the eccentrics; that is a crank matter, not a gear
 //! one.) What can fail is spacing (neighbouring planets' tip circles overlap) and continuity
 //! of mesh (contact ratio below 1); both are checked.
+//!
+//! Theory: docs/model.md, section "Geometry" of "First-stage mesh".
 
 use crate::error::{Result, RvdynError, num, require_non_negative};
 use crate::geometry::cycloid::require_length;
@@ -353,10 +355,7 @@ impl InvoluteStage {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     fn paper() -> InvoluteStage {
         InvoluteStage::new(18, 42, 3, 0.003, 20f64.to_radians(), 0.030).unwrap()

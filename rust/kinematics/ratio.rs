@@ -99,10 +99,7 @@ pub fn body_speeds(input_speed: f64, z_sun: u32, z_planet: u32, pins: u32) -> Re
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * a.abs().max(b.abs())
-    }
+    use crate::test_util::close;
 
     #[test]
     fn paper_ratio_is_57() {

@@ -59,12 +59,6 @@ pub(crate) struct PyCycloidGeometry {
 }
 
 impl PyCycloidGeometry {
-    /// The core geometry (for other bindings).
-    #[allow(dead_code)]
-    pub(crate) fn core(&self) -> &CycloidGeometry {
-        &self.inner
-    }
-
     /// Evaluate `f` (returning `N` values per angle) over an array of angles, GIL released.
     /// The result's size and dimensions are checked before anything is allocated; a
     /// non-finite value is an error naming `what`, never returned.

@@ -50,6 +50,8 @@
 //!
 //! **Limits.** The step stays in `[h_min, h_max]`; below `h_min`, or beyond `max_steps`
 //! accepted steps, the run stops with a `SimulationError` naming the time and the cause.
+//!
+//! Theory: docs/model.md, section "Error-controlled generalized-alpha".
 
 use crate::error::{Result, RvdynError};
 use crate::solve::dopri5::VELOCITY_ERROR_TIME;

@@ -5,6 +5,8 @@
 //! `atol + rtol |v_i| L_i tau` with `tau = 1 ms`, so that `atol` bounds both the displacement
 //! error and the displacement a velocity error makes within a millisecond. No relative
 //! tolerance on positions: absolute angles grow without bound and say nothing about accuracy.
+//!
+//! Theory: docs/model.md, section "Dormand-Prince 5(4)".
 
 use crate::error::{Result, RvdynError};
 use crate::solve::integrator::{Integrator, IntegratorEntry, Settings, Stats};
@@ -295,17 +297,17 @@ impl Dopri5 {
         let n = st.q.len();
         let mut sum = 0.0;
         for i in 0..n {
-            let (mut eq, mut ev) = (0.0, 0.0);
+            let (mut e_q, mut e_v) = (0.0, 0.0);
             for s in 0..7 {
-                eq += E[s] * self.kq[s][i];
-                ev += E[s] * self.kv[s][i];
+                e_q += E[s] * self.kq[s][i];
+                e_v += E[s] * self.kv[s][i];
             }
             let l = scale[i];
-            let wq = (h * eq * l) / self.atol;
+            let w_q = (h * e_q * l) / self.atol;
             let vmax = st.v[i].abs().max(self.v[i].abs());
-            let wv = (h * ev * l * VELOCITY_ERROR_TIME)
+            let w_v = (h * e_v * l * VELOCITY_ERROR_TIME)
                 / (self.atol + self.rtol * vmax * l * VELOCITY_ERROR_TIME);
-            sum += wq * wq + wv * wv;
+            sum += w_q * w_q + w_v * w_v;
         }
         (sum / (2 * n) as f64).sqrt()
     }

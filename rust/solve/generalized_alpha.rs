@@ -6,24 +6,27 @@
 //!
 //! With `M` folded into `f = M^-1 Q`, each step solves for the acceleration `a1` at `t + h`:
 //! `R(a1) = a1 - f(t + h, q1, v1) = 0`, with
-//! `(1 - am) p1 + am p0 = (1 - af) a1 + af a0`,
-//! `q1 = q0 + h v0 + h^2 ((1/2 - b) p0 + b p1)`, `v1 = v0 + h ((1 - g) p0 + g p1)`, and the
-//! parameters of Chung & Hulbert (J. Appl. Mech. 60, 1993) from `rho_inf`. For a linear system
-//! this is the Chung-Hulbert method; for the strongly nonlinear contact forces here it is
-//! 5-9 times more accurate at large steps, because the forces are evaluated at the step ends
-//! instead of at alpha-weighted intermediate states (measured on the paper scenes:
-//! `examples/ga_experiment.rs`). The state's `a` is then the true acceleration, as the cubic
-//! Hermite output between steps assumes.
+//! `(1 - alpha_m) p1 + alpha_m p0 = (1 - alpha_f) a1 + alpha_f a0`,
+//! `q1 = q0 + h v0 + h^2 ((1/2 - beta) p0 + beta p1)`,
+//! `v1 = v0 + h ((1 - gamma) p0 + gamma p1)`, and the parameters of Chung & Hulbert (J. Appl.
+//! Mech. 60, 1993) from `rho_inf`. For a linear system this is the Chung-Hulbert method; for
+//! the strongly nonlinear contact forces here it is 5-9 times more accurate at large steps,
+//! because the forces are evaluated at the step ends instead of at alpha-weighted intermediate
+//! states (measured on the paper scenes: `examples/ga_experiment.rs`). The state's `a` is then
+//! the true acceleration, as the cubic Hermite output between steps assumes.
 //!
-//! `p` approximates the acceleration at `t + (am - af) h` (Arnold & Bruls 2007, section 3); it
-//! starts as `a` (restart), and when the step changes from `h` to `h'` its shift is rescaled,
-//! `p <- a + (h'/h) (p - a)`.
+//! `p` approximates the acceleration at `t + (alpha_m - alpha_f) h` (Arnold & Bruls 2007,
+//! section 3); it starts as `a` (restart), and when the step changes from `h` to `h'` its shift
+//! is rescaled, `p <- a + (h'/h) (p - a)`.
 //!
-//! Newton uses a finite-difference Jacobian
-//! `J = I - s (b h^2 K + g h C)`, `s = (1 - af)/(1 - am)`, `K = df/dq`, `C = df/dv`, reused
-//! across steps while Newton converges fast (re-assembled without new force evaluations when
-//! only the step changes); a step whose Newton stalls is retried with a fresh Jacobian and then
+//! Newton uses a finite-difference Jacobian `J = I - s (beta h^2 K + gamma h C)`,
+//! `s = (1 - alpha_f)/(1 - alpha_m)`, `K = df/dq`, `C = df/dv`, reused across steps while
+//! Newton converges fast (re-assembled without new force evaluations when only the step
+//! changes); a step whose Newton stalls is retried with a fresh Jacobian and then
 //! split in halves (down to 1/1024 of the step) before the run is declared failed.
+//!
+//! Theory: docs/model.md, sections "Generalized-alpha (Arnold & Bruls form) with Newton"
+//! and "Newton tolerance of generalized-alpha".
 
 use crate::error::{Result, RvdynError};
 use crate::solve::integrator::{FixedClock, Integrator, IntegratorEntry, Settings, Stats};
@@ -87,8 +90,8 @@ struct Vectors<'a> {
 /// Generalized-alpha stepper with Jacobian reuse.
 #[derive(Debug)]
 pub struct GeneralizedAlpha {
-    am: f64,
-    af: f64,
+    alpha_m: f64,
+    alpha_f: f64,
     beta: f64,
     gamma: f64,
     /// Newton tolerance on the displacement increment \[m\].
@@ -149,13 +152,13 @@ impl GeneralizedAlpha {
                 "rho_inf must be in [0, 1] (1 = no numerical damping), got {rho_inf}"
             )));
         }
-        let am = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
-        let af = rho_inf / (rho_inf + 1.0);
-        let gamma = 0.5 - am + af;
-        let beta = 0.25 * (1.0 - am + af).powi(2);
+        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+        let alpha_f = rho_inf / (rho_inf + 1.0);
+        let gamma = 0.5 - alpha_m + alpha_f;
+        let beta = 0.25 * (1.0 - alpha_m + alpha_f).powi(2);
         Ok(Self {
-            am,
-            af,
+            alpha_m,
+            alpha_f,
             beta,
             gamma,
             newton_tol,
@@ -361,10 +364,10 @@ impl GeneralizedAlpha {
             r,
         } = vectors;
         let n = st.q.len();
-        let (am, af, b, g) = (self.am, self.af, self.beta, self.gamma);
+        let (alpha_m, alpha_f, beta, gamma) = (self.alpha_m, self.alpha_f, self.beta, self.gamma);
         let scale = sys.length_scale();
         // dq1/da1.
-        let dq_da = b * h * h * (1.0 - af) / (1.0 - am);
+        let dq_da = beta * h * h * (1.0 - alpha_f) / (1.0 - alpha_m);
         let mut power = [0.0; 3];
         let t1 = st.t + h;
         let Some(lu) = self.lu.as_ref() else {
@@ -372,9 +375,10 @@ impl GeneralizedAlpha {
         };
         let update = |a1: &[f64], p1: &mut [f64], q1: &mut [f64], v1: &mut [f64]| {
             for i in 0..n {
-                p1[i] = ((1.0 - af) * a1[i] + af * st.a[i] - am * p0[i]) / (1.0 - am);
-                q1[i] = st.q[i] + h * st.v[i] + h * h * ((0.5 - b) * p0[i] + b * p1[i]);
-                v1[i] = st.v[i] + h * ((1.0 - g) * p0[i] + g * p1[i]);
+                p1[i] = ((1.0 - alpha_f) * a1[i] + alpha_f * st.a[i] - alpha_m * p0[i])
+                    / (1.0 - alpha_m);
+                q1[i] = st.q[i] + h * st.v[i] + h * h * ((0.5 - beta) * p0[i] + beta * p1[i]);
+                v1[i] = st.v[i] + h * ((1.0 - gamma) * p0[i] + gamma * p1[i]);
             }
         };
         let mut previous_size = f64::NAN;
@@ -398,8 +402,9 @@ impl GeneralizedAlpha {
             for i in 0..n {
                 a1[i] -= delta[i];
                 size = size.max((dq_da * delta[i] * scale[i]).abs());
-                let p1i = ((1.0 - af) * a1[i] + af * st.a[i] - am * p0[i]) / (1.0 - am);
-                let e_q = h * h * ((0.5 - b) * p0[i] + b * p1i - st.a[i] / 3.0 - a1[i] / 6.0);
+                let p1i = ((1.0 - alpha_f) * a1[i] + alpha_f * st.a[i] - alpha_m * p0[i])
+                    / (1.0 - alpha_m);
+                let e_q = h * h * ((0.5 - beta) * p0[i] + beta * p1i - st.a[i] / 3.0 - a1[i] / 6.0);
                 local = local.max((e_q * scale[i]).abs());
             }
             if !size.is_finite() {
@@ -488,13 +493,13 @@ impl GeneralizedAlpha {
         Ok(())
     }
 
-    /// Assemble and factor `J = I - s (b h^2 K + g h C)` for the step `h`.
+    /// Assemble and factor `J = I - s (beta h^2 K + gamma h C)` for the step `h`.
     fn factor(&mut self, h: f64) {
         let Some((kq, kv)) = self.stiffness.as_ref() else {
             return;
         };
         let n = kq.nrows();
-        let s = (1.0 - self.af) / (1.0 - self.am);
+        let s = (1.0 - self.alpha_f) / (1.0 - self.alpha_m);
         let (cq, cv) = (s * self.beta * h * h, s * self.gamma * h);
         let jac = DMatrix::from_fn(n, n, |i, k| {
             let id = if i == k { 1.0 } else { 0.0 };

@@ -159,7 +159,8 @@ fn check_energy(
     let Some(e) = sys.energy(st.t, &st.q, &st.v)? else {
         return Ok(());
     };
-    // Residual growth and energy exchanged since `from`.
+    // The residual's growth over an interval is judged against the energy exchanged in it
+    // (the largest of |dE| and each work), not against the stored energy.
     let since = |from: (f64, [f64; 3], f64)| {
         let (e0, w0, r0) = from;
         let dw: [f64; 3] = std::array::from_fn(|j| st.work[j] - w0[j]);

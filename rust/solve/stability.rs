@@ -1,6 +1,8 @@
 //! Linearised stability of the explicit fixed-step method (RK4) at a state: an explicit method
 //! beyond its stability limit can return smooth-looking but wrong results (a mode flipping
 //! sign every step), so the driver checks the limit from time to time and stops with advice.
+//!
+//! Theory: docs/model.md, section "RK4 and its stability check".
 
 use crate::error::Result;
 use crate::solve::{MechanicalSystem, State, jacobian};

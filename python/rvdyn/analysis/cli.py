@@ -55,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
         scene = Scene.load(args.scene)
     else:
         scene = Scene.physical("rated") if args.preset == "physical" else Scene.paper("rated")
-    # The options' own limits, before any work (they used to fail after the LTCA).
+    # The options' own limits are checked before any work, not after the LTCA.
     from ..errors import ParameterError
 
     if args.angles is not None and args.angles < 2:

@@ -742,9 +742,8 @@ fn stick(held: Option<f64>, direction: f64, slide: f64) -> f64 {
 
 /// The loop's torques `0 -> +rated -> 0 -> -rated -> 0`, linear in the point index within each
 /// quarter, with `points - 1` steps shared among the quarters as evenly as whole numbers allow
-/// (so that `+-rated` and the zeros are always points: with 10 points the tip used to be 0.89
-/// rated), and `|rated|`. Errors (`Parameter`) for a non-finite or zero rated torque or fewer
-/// than 8 points.
+/// (so that `+-rated` and the zeros are always points, whatever the count), and `|rated|`.
+/// Errors (`Parameter`) for a non-finite or zero rated torque or fewer than 8 points.
 pub(crate) fn loop_torques(rated: f64, points: usize) -> Result<(Vec<f64>, f64)> {
     crate::error::require_finite("rated torque", rated)?;
     let rated = rated.abs();

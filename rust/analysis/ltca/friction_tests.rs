@@ -40,7 +40,7 @@ fn pin_friction_lever_sum(p: &LtcaPoint) -> f64 {
 #[test]
 fn zero_friction_gives_the_closed_loop() {
     let mut modified = Scene::paper("rated").unwrap();
-    modified.joints = crate::dynamics::compliant::default_joints();
+    modified.joints = crate::dynamics::model::compliant::default_joints();
     modified.cycloid.d_rrp = 2e-5;
     modified.cycloid.d_rp = -2e-5;
     for s in [Scene::physical("rated").unwrap(), modified] {

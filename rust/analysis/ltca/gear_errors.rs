@@ -113,10 +113,10 @@ pub(crate) fn period_units(scene: &Scene) -> u64 {
 mod tests {
     use super::*;
     use crate::analysis::ltca::statics::{ContactState, Family, Kind, Statics, Work};
-    use crate::dynamics::compliant::CompliantModel;
-    use crate::dynamics::rigid::RigidModel;
+    use crate::dynamics::model::compliant::CompliantModel;
+    use crate::dynamics::model::rigid::RigidModel;
+    use crate::dynamics::run::sink::NoSink;
     use crate::dynamics::scene::{Drive, GearError, Joints};
-    use crate::dynamics::sink::NoSink;
     use crate::solve::MechanicalSystem;
 
     /// Runout and pitch errors of 3-10 um on the sun and every planet (sinusoid and table).
@@ -154,7 +154,7 @@ mod tests {
                 *crank_bearing = None;
                 out.push(s.clone());
             } else {
-                s.joints = crate::dynamics::compliant::default_joints();
+                s.joints = crate::dynamics::model::compliant::default_joints();
                 out.push(s.clone());
             }
         }

@@ -1174,7 +1174,8 @@ pub(crate) fn zero_side_torque(rated: f64) -> f64 {
     (1e-7 * rated).max(ZERO_SIDE_FLOOR).min(0.01 * rated)
 }
 
-/// The smallest torque of a loop's zero-torque points [N m] (see [`zero_side_torque`]).
+/// The smallest torque of a loop's zero-torque points [N m]: they are taken at 1e-7 of the
+/// rated torque, but at least this and at most 1 % of the rated torque.
 pub const ZERO_SIDE_FLOOR: f64 = 1e-3;
 
 /// The crank-angle period after which the whole contact pattern repeats \[rad\].

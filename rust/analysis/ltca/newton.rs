@@ -286,8 +286,8 @@ const MIN_LOAD_OVER_FLOOR: f64 = 1e3;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonOptions {
     /// Converged when every scaled residual `|Q_a| / L_a` is below `tolerance` times the load
-    /// scale `|T| / rp` (or below the round-off floor of the force evaluation, ~1e2 eps
-    /// k_ref rp), or when the residual is below 1e-9 of that scale and the next Newton
+    /// scale `|T| / rp` (or below the round-off floor of the force evaluation,
+    /// `~1e2 eps k_ref rp`), or when the residual is below 1e-9 of that scale and the next Newton
     /// correction is round-off (below 16 ulps of `rp` on every unknown).
     pub tolerance: f64,
     /// Most iterations per equilibrium.

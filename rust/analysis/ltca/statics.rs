@@ -2,9 +2,9 @@
 //!
 //! Everything is evaluated in the full coordinates of the compliant-joint model
 //! (`x = [th_c, th_s, (x_i, y_i, alpha_i) per crank, (X_k, Y_k, theta_k) per disc]`, see
-//! `dynamics::compliant`), at zero velocity: `Q(x)` and `K(x) = -dQ/dx`. The rigid-joint model
-//! and the compliant model with rigid crank bearings are maps `x = x(q)` from fewer unknowns
-//! `q`; their forces and stiffness follow by the chain rule
+//! `dynamics::model::compliant`), at zero velocity: `Q(x)` and `K(x) = -dQ/dx`. The
+//! rigid-joint model and the compliant model with rigid crank bearings are maps `x = x(q)` from
+//! fewer unknowns `q`; their forces and stiffness follow by the chain rule
 //! `Q_q = J^T Q_x`, `K_q = J^T K_x J - sum_r Q_x,r hess(x_r)` (`J = dx/dq`).
 //!
 //! Every coupling is a scalar or vector deflection of the coordinates with its gradient and
@@ -28,8 +28,8 @@ use crate::contact::line_contact::PinDiscLawBase;
 use crate::contact::pin_tangent::{
     GapJet, centre_curve_derivatives_cs, foot_jet_with, gap_jet_cs, line_jet, line_jet_checked,
 };
-use crate::dynamics::model::laws::{BearingLaw, ContactLaw};
-use crate::dynamics::rigid::RigidModel;
+use crate::dynamics::model::laws::BearingLaw;
+use crate::dynamics::model::rigid::RigidModel;
 use crate::dynamics::scene::{Joints, ProfileError, Scene};
 use crate::error::{Result, RvdynError};
 use crate::geometry::gap::small_sin_cos;
@@ -640,7 +640,6 @@ impl Statics {
             s.crank_bearing_force.reserve(nc);
             s.eccentric_bearing_force.reserve(nc * nd);
         }
-        // Pins.
         for (k, d) in m.discs.iter().enumerate() {
             let dk = self.disc_index(k);
             let o = [x[dk], x[dk + 1]];
@@ -833,7 +832,8 @@ impl Statics {
                 let rot = rbs * (x[SUN] - thc) + rbp * (alpha - thc);
                 let half = 0.5 * mm.backlash;
                 let idx = [SUN, CARRIER, ci + 2, ci, ci + 1];
-                // Mesh position along the line of action (the dynamic models' `s`).
+                // `s_i` as in the dynamic models (docs/model.md, "The ISO mesh in the dynamic
+                // models"), so the LTCA meets the same stiffness wave at the same pose.
                 let s_mesh = rbs * (x[SUN] - thc) - mm.phases[i] * mm.base_pitch;
                 let mut f_report = 0.0;
                 let mut e_drive = 0.0;
@@ -1023,7 +1023,8 @@ impl Statics {
         };
         match self.kind {
             Kind::Rigid => {
-                // th_c: carrier, disc angles, crank seats.
+                // dx/dth_c of the rigid-joint map: the carrier and every disc angle turn one
+                // for one, each crank seat moves along z x s_i.
                 let col = &mut work.jac[0];
                 col.push((CARRIER, 1.0));
                 for k in 0..m.discs.len() {
@@ -1322,7 +1323,8 @@ impl Default for Work {
 /// \[m\] (the laws [`Statics::new`] accepts).
 #[inline]
 pub fn elastic(law: &ImpactLaw, pen: f64) -> (f64, f64) {
-    ContactLaw::Impact(*law).elastic_force_and_stiffness(pen)
+    let (force, stiffness, _) = law.force_and_derivatives(pen, 0.0);
+    (force, stiffness)
 }
 
 /// A mesh flank's static law at one pose: `V(pen, s)` and its derivatives.
@@ -1372,7 +1374,7 @@ fn mesh_static(law: &MeshLaw, pen: f64, s: f64) -> MeshStatic {
 /// Damping coefficient [N s/m] of an IMPACT law at penetration `pen` \[m\] (at zero rate).
 #[inline]
 pub fn contact_damping(law: &ImpactLaw, pen: f64) -> f64 {
-    ContactLaw::Impact(*law).damping_coefficient(pen)
+    law.force_and_derivatives(pen, 0.0).2
 }
 
 /// Add `J_d^T c J_d` for a bearing with deflection Jacobian columns `cols`.
@@ -1414,9 +1416,9 @@ fn add_bearing(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dynamics::compliant::CompliantModel;
+    use crate::dynamics::model::compliant::CompliantModel;
+    use crate::dynamics::run::sink::NoSink;
     use crate::dynamics::scene::Scene;
-    use crate::dynamics::sink::NoSink;
     use crate::solve::MechanicalSystem;
 
     fn rng(seed: u64) -> impl FnMut() -> f64 {
@@ -1439,7 +1441,7 @@ mod tests {
         m.stage1.as_mut().unwrap().backlash = 2e-5;
         out.push(m.clone());
         let mut c = m.clone();
-        c.joints = crate::dynamics::compliant::default_joints();
+        c.joints = crate::dynamics::model::compliant::default_joints();
         out.push(c.clone());
         let mut c2 = c.clone();
         if let Joints::Compliant {
@@ -1458,14 +1460,14 @@ mod tests {
         single.stage1 = None;
         out.push(single.clone());
         let mut single_c = single;
-        single_c.joints = crate::dynamics::compliant::default_joints();
+        single_c.joints = crate::dynamics::model::compliant::default_joints();
         out.push(single_c);
         out.extend(physical_scenes());
         // Disc profile errors (harmonics and a table) at rigid and compliant joints.
         let mut pe = m.clone();
         with_profile_errors(&mut pe);
         out.push(pe.clone());
-        pe.joints = crate::dynamics::compliant::default_joints();
+        pe.joints = crate::dynamics::model::compliant::default_joints();
         out.push(pe);
         // Assembly errors (compliant joints only), with compliant and rigid crank bearings.
         let mut ae = c.clone();
@@ -1635,7 +1637,7 @@ mod tests {
         use crate::dynamics::model::ReducerModel;
         let mut scene = Scene::paper("rated").unwrap();
         scene.cycloid.d_rrp = 1e-5;
-        scene.joints = crate::dynamics::compliant::default_joints();
+        scene.joints = crate::dynamics::model::compliant::default_joints();
         scene.drive = crate::dynamics::scene::Drive::Torque {
             torque: 0.0,
             ramp_time: 0.0,
@@ -1700,7 +1702,7 @@ mod tests {
         let mut scene = Scene::paper("rated").unwrap();
         scene.cycloid.d_rrp = 2e-5;
         scene.cycloid.d_rp = -2e-5;
-        scene.joints = crate::dynamics::compliant::default_joints();
+        scene.joints = crate::dynamics::model::compliant::default_joints();
         let mut with_errors = scene.clone();
         with_profile_errors(&mut with_errors);
         for scene in [scene, with_errors] {
@@ -1747,7 +1749,7 @@ mod tests {
         let mut scene = Scene::paper("rated").unwrap();
         scene.cycloid.d_rrp = 2e-5;
         scene.cycloid.d_rp = -2e-5;
-        scene.joints = crate::dynamics::compliant::default_joints();
+        scene.joints = crate::dynamics::model::compliant::default_joints();
         let mut skipping = Statics::new(&scene).unwrap();
         let mut never = Statics::new(&scene).unwrap();
         never.skip = false;

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::analysis::classical_pin_forces;
-use crate::dynamics::compliant::default_joints;
+use crate::dynamics::model::compliant::default_joints;
 use crate::dynamics::scene::{ContactLawSpec, Joints};
 use crate::geometry::CycloidGeometry;
 

@@ -735,8 +735,3 @@ fn full_names(st: &Statics) -> Vec<String> {
     }
     v
 }
-
-/// Whether a scene has compliant joints.
-pub fn is_compliant(scene: &Scene) -> bool {
-    matches!(scene.joints, Joints::Compliant { .. })
-}

@@ -285,7 +285,7 @@ fn negative_stiffness_direction_is_flagged_unstable() {
 
 // ---- linearised reducer models ---------------------------------------------------------------
 
-use crate::dynamics::compliant::default_joints;
+use crate::dynamics::model::compliant::default_joints;
 use crate::dynamics::scene::{Bearing, Joints, Scene};
 
 fn rated_torque() -> f64 {
@@ -553,7 +553,7 @@ fn print_paper_mode_tables() {
 fn damped_eigenvalues_are_roots_of_the_pencil() {
     use crate::dynamics::scene::Scene;
     let mut scene = Scene::paper("rated").unwrap();
-    scene.joints = crate::dynamics::compliant::default_joints();
+    scene.joints = crate::dynamics::model::compliant::default_joints();
     for scene in [scene, Scene::physical("rated").unwrap()] {
         let mut lin = Linearizer::new(&scene).unwrap();
         let torque = scene.load.torque(0.0);

@@ -1,97 +1,10 @@
-//! The force laws of the model, each family evaluated in one place: the contact law of a
-//! penetration (pins, meshes) and the law of a bearing. New families (roller bearings,
-//! friction, ISO mesh stiffness, line contact) are new variants here; the models call only
-//! these methods.
+//! The radial force laws of the bearings ([`BearingLaw`], [`linear_bearing`]) used by the
+//! models and the quasi-static analysis. The pin and mesh contact laws are in
+//! [`crate::contact::law`].
 
-use crate::contact::ImpactLaw;
 use crate::dynamics::model::vec2::dot;
-use crate::dynamics::scene::{Bearing, ContactLawSpec};
+use crate::dynamics::scene::Bearing;
 use crate::error::Result;
-
-/// The normal force law of a contact with penetration `x` \[m\] and penetration rate [m/s].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum ContactLaw {
-    /// `F = k x^e + STEP(x, 0, 0, d, cmax) xdot`, `F >= 0` (ADAMS IMPACT; the Palmgren line
-    /// contact of the scene is this law with `e = 10/9`): docs/model.md#contact-laws.
-    Impact(ImpactLaw),
-}
-
-impl ContactLaw {
-    /// The law a scene specifies for a contact of length `face_width` \[m\].
-    pub fn from_spec(spec: &ContactLawSpec, face_width: f64) -> Result<Self> {
-        Ok(ContactLaw::Impact(spec.law(face_width)?))
-    }
-
-    /// Normal force \[N\] (>= 0) at penetration `x` \[m\] (> 0) and rate `rate` [m/s].
-    #[inline]
-    pub fn force(&self, x: f64, rate: f64) -> f64 {
-        match self {
-            ContactLaw::Impact(l) => l.force(x, rate),
-        }
-    }
-
-    /// The elastic (conservative) part of the force \[N\].
-    #[inline]
-    pub fn elastic_force(&self, x: f64) -> f64 {
-        match self {
-            ContactLaw::Impact(l) => l.elastic_force(x),
-        }
-    }
-
-    /// Elastic energy stored at penetration `x` \[J\].
-    #[inline]
-    pub fn elastic_energy(&self, x: f64) -> f64 {
-        match self {
-            ContactLaw::Impact(l) => l.elastic_energy(x),
-        }
-    }
-
-    /// Elastic force \[N\] and its derivative, the static contact stiffness [N/m], at penetration
-    /// `x` \[m\] (both 0 for `x <= 0`): the contact's part of the tangent stiffness (quasi-static
-    /// analysis and modes).
-    #[inline]
-    pub fn elastic_force_and_stiffness(&self, x: f64) -> (f64, f64) {
-        if x <= 0.0 {
-            return (0.0, 0.0);
-        }
-        match self {
-            ContactLaw::Impact(l) => {
-                let (f, df, _) = l.force_and_derivatives(x, 0.0);
-                (f, df)
-            }
-        }
-    }
-
-    /// Damping coefficient `dF/dx'` [N s/m] at penetration `x` \[m\] and zero rate (0 for
-    /// `x <= 0`): the contact's part of the linearised damping matrix.
-    #[inline]
-    pub fn damping_coefficient(&self, x: f64) -> f64 {
-        if x <= 0.0 {
-            return 0.0;
-        }
-        match self {
-            ContactLaw::Impact(l) => l.force_and_derivatives(x, 0.0).2,
-        }
-    }
-
-    /// A mesh with total backlash `backlash` \[m\] along the line of action at deflection
-    /// `delta` \[m\] (positive on the drive flank) and rate `rate` [m/s]: the signed force \[N\]
-    /// (negative on the coast flank), its signed elastic part, the penetration \[m\] (0 inside
-    /// the backlash) and the penetration rate [m/s].
-    #[inline]
-    pub fn mesh(&self, backlash: f64, delta: f64, rate: f64) -> (f64, f64, f64, f64) {
-        let half = 0.5 * backlash;
-        if delta > half {
-            let p = delta - half;
-            (self.force(p, rate), self.elastic_force(p), p, rate)
-        } else if delta < -half {
-            let p = -delta - half;
-            (-self.force(p, -rate), -self.elastic_force(p), p, -rate)
-        } else {
-            (0.0, 0.0, 0.0, 0.0)
-        }
-    }
-}
 
 /// Force of one bearing and its energy flows.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

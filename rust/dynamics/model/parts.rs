@@ -479,10 +479,15 @@ impl MeshErrors {
     }
 
     /// Extra approach of flank `sign` (+1 drive, -1 coast) of mesh `i` at carrier angle
-    /// `thc`, sun angle `ths` and absolute crank angle `alpha` \[rad\]:
-    /// `E = sign cos(pa) (F_s(th_c + g_i - th_s) + F_p(th_c + g_i + pi - alpha))
-    /// + e_s cos(th_s + p_s - psi) - e_p cos(alpha + p_p - psi)`, with
-    /// `psi = th_c + g_i + sign (pi/2 - pa)` the direction of the flank's line of action.
+    /// `th_c` (argument `thc`), sun angle `th_s` (`ths`) and absolute crank angle `alpha`
+    /// \[rad\]:
+    ///
+    /// ```text
+    /// E = sign cos(pa) (F_s(th_c + g_i - th_s) + F_p(th_c + g_i + pi - alpha))
+    ///     + e_s cos(th_s + p_s - psi) - e_p cos(alpha + p_p - psi)
+    /// ```
+    ///
+    /// with `psi = th_c + g_i + sign (pi/2 - pa)` the direction of the flank's line of action.
     pub(crate) fn offset(&self, i: usize, sign: f64, thc: f64, ths: f64, alpha: f64) -> MeshOffset {
         use std::f64::consts::{FRAC_PI_2, PI};
         let g = self.gamma[i];

@@ -3,8 +3,8 @@
 //! Coordinates `x = [th_c, alpha, th_s]`: carrier angle, absolute crank angle (all cranks equal
 //! when the joints are ideal), sun angle. Disc `k` (eccentric phase `a_k`) has its centre at
 //! `O_k = e (cos(alpha + a_k), sin(alpha + a_k))` and turns with the carrier,
-//! `theta_k = th_c - a_k / zc` (the half-lobe offset of the second disc). The mass matrix is
-//! diagonal and constant in these coordinates:
+//! `theta_k = th_c + delta_k`, `delta_k = -a_k / zc` (the half-lobe offset of the second disc).
+//! The mass matrix is diagonal and constant in these coordinates:
 //! `M_cc = J_c + J_load + n_cr m_cr r_cr^2 + sum J_d`, `M_aa = n_cr J_cr + sum m_d e^2`,
 //! `M_ss = J_s`. Generalised forces come from virtual work: a pin force `-F N` at the profile
 //! point `X` of disc `k` gives `Q_c = -F N.(z x (X - O_k))`, `Q_a = -F N.(z x O_k)`; a mesh
@@ -356,7 +356,6 @@ impl RigidModel {
                 out.dissipation += (f - lf.elastic) * pen_rate;
                 out.potential += lf.energy;
                 let point = [o[0] + pc.arm[0], o[1] + pc.arm[1]];
-                // Moment of the pin's force (-f n) on the disc about the disc centre.
                 sink.pin(k, j, f, pen, -f * lever_c, point, n);
             }
         }
@@ -364,7 +363,8 @@ impl RigidModel {
             let delta = m.sun_base_radius * (x[SUN] - x[CARRIER])
                 + m.planet_base_radius * (x[CRANK] - x[CARRIER]);
             let rate = m.sun_base_radius * (v[SUN] - vc) + m.planet_base_radius * (va - vc);
-            // Mesh position along the line of action (sun relative to the carrier).
+            // The part of `s_i = r_bs (th_s - th_c) + gamma_i p_b` shared by all planets
+            // (docs/model.md, "The ISO mesh in the dynamic models").
             let s0 = m.sun_base_radius * (x[SUN] - x[CARRIER]);
             let half = 0.5 * m.backlash;
             // Drive flank (delta > half) or coast flank (delta < -half): the same base

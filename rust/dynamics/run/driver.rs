@@ -549,8 +549,8 @@ pub fn run_with<M: ReducerModel>(
     } else {
         Vec::new()
     };
-    // Round-off allowance of a sample time against the clock: 1e-12 s, but far below the
-    // interval itself (at t_end = 1e-12 s the second sample was taken at t = 0).
+    // Round-off allowance of a sample time against the clock: 1e-12 s, but at most 1e-6 of
+    // the interval, so that a sample is never taken one interval early in a very short run.
     let slack = 1e-12f64.min(1e-6 * interval);
     while next_sample < n_samples && next_sample as f64 * interval <= st.t + slack {
         record(&mut rec, &st)?;

@@ -1042,7 +1042,8 @@ mod tests {
 
     #[test]
     fn unknown_fields_are_rejected_in_tagged_enums_too() {
-        // Issue 12 D11: serde's deny_unknown_fields does not reach internally tagged enums.
+        // serde's deny_unknown_fields does not reach internally tagged enums, so a misspelt
+        // field there must still be an error.
         let base = Scene::paper("idle").unwrap();
         for (path, value) in [
             (

@@ -281,7 +281,6 @@ impl CompliantModel {
                 }
                 out.dissipation += (f - lf.elastic) * pen_rate;
                 out.potential += lf.energy;
-                // Moment of the pin's force (-f n) on the disc about the disc centre.
                 sink.pin(k, j, f, pen, -f * lever, add(o, pc.arm), n);
             }
         }

@@ -19,9 +19,10 @@
 //!   reaction on the carrier at `s_i`);
 //! - eccentric bearing `(i, k)`: a radial spring-damper on `d = H_ik - E_ik` between the
 //!   eccentric centre `E_ik = p_i + e (cos(alpha_i + a_k), sin(alpha_i + a_k))` and the disc
-//!   hole centre `H_ik = O_k + R(theta_k) h_ik`, `h_ik = R(-d_k) r_cr (cos gamma_i,
-//!   sin gamma_i)`, `d_k = -a_k / zc`; in the kinematic pose (`p_i = s_i`, `alpha_i = alpha`,
-//!   `O_k = e (cos(alpha + a_k), sin(alpha + a_k))`, `theta_k = th_c + d_k`) `H = E` exactly;
+//!   hole centre `H_ik = O_k + R(theta_k) h_ik`, `h_ik = R(-delta_k) r_cr (cos gamma_i,
+//!   sin gamma_i)`, `delta_k = -a_k / zc`; in the kinematic pose (`p_i = s_i`,
+//!   `alpha_i = alpha`, `O_k = e (cos(alpha + a_k), sin(alpha + a_k))`,
+//!   `theta_k = th_c + delta_k`) `H = E` exactly;
 //! - a bearing spring-damper with radial clearance `c` acts only when `|d| > c`, with magnitude
 //!   `k (|d| - c) + c_b d|d|/dt`, clamped at 0 (it cannot pull), along `d / |d|`; with `c = 0`
 //!   it is the linear vector spring-damper `F = -k d - c_b d'`;
