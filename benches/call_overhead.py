@@ -33,4 +33,7 @@ def main(calls: int = 300) -> None:
 
 
 if __name__ == "__main__":
+    import argparse
+
+    argparse.ArgumentParser(description=__doc__).parse_args()
     main()

@@ -3,8 +3,11 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
+
+argparse.ArgumentParser(description=__doc__).parse_args()
 
 root = Path(__file__).resolve().parent.parent / "target" / "criterion"
 print("| bench | median | 95 % interval |\n|---|---|---|")

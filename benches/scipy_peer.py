@@ -49,8 +49,17 @@ from rvdyn import Scene, simulate
 # Sample interval [s] of both sides and span of the equal-error runs [s]:
 # `python benches/scipy_peer.py 1e-3` runs the comparison with 1 ms samples (results in
 # scipy_peer_1ms.*), `python benches/scipy_peer.py 1e-3 1.0` over 1 s (scipy_peer_1ms_1s.*).
-RECORD_INTERVAL = float(sys.argv[1]) if len(sys.argv) > 1 else 1e-4
-T_RUN = float(sys.argv[2]) if len(sys.argv) > 2 else 0.2  # span of the equal-error runs [s]
+def _arguments() -> tuple[float, float]:
+    import argparse
+
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("record_interval", nargs="?", type=float, default=1e-4, help="sample interval [s]")
+    p.add_argument("t_run", nargs="?", type=float, default=0.2, help="span of the equal-error runs [s]")
+    a = p.parse_args()
+    return a.record_interval, a.t_run
+
+
+RECORD_INTERVAL, T_RUN = _arguments()
 SUFFIX = ("" if RECORD_INTERVAL == 1e-4 else f"_{RECORD_INTERVAL * 1e3:g}ms") + (
     "" if T_RUN == 0.2 else f"_{T_RUN:g}s")
 CHANNELS = ["motion", "pins"]

@@ -71,4 +71,8 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    import argparse
+
+    # No options: --help describes the run instead of starting it (it rewrites benches/results).
+    argparse.ArgumentParser(description=__doc__).parse_args()
     sys.exit(main())

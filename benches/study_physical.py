@@ -86,7 +86,11 @@ def main() -> None:
           f" start-up {startup:.1f} s, {errors} error rows")
     print(f"yield TE <= 1 arcmin: {y.rate.value:.5f} [{y.rate.low:.5f}, {y.rate.high:.5f}] ({y.method})")
     for metric in ("te_pp_forward", "peak_pin_force"):
-        s = src(table, metric)
+        try:
+            s = src(table, metric)
+        except rvdyn.ParameterError as e:  # too few samples for a regression: keep the rest
+            print(f"SRC {metric}: skipped ({e})")
+            continue
         top = ", ".join(f"{n} {v:+.3f}" for n, v in s.top(3))
         print(f"SRC {metric}: {top} (R^2 {s.r2:.3f})")
     for metric, stats in describe(table, ["te_pp_forward", "peak_pin_force"]).items():

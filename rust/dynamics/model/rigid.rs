@@ -363,7 +363,7 @@ impl RigidModel {
             let delta = m.sun_base_radius * (x[SUN] - x[CARRIER])
                 + m.planet_base_radius * (x[CRANK] - x[CARRIER]);
             let rate = m.sun_base_radius * (v[SUN] - vc) + m.planet_base_radius * (va - vc);
-            // The part of `s_i = r_bs (th_s - th_c) + gamma_i p_b` shared by all planets
+            // The part of `s_i = r_bs (th_s - th_c) - gamma_i p_b` shared by all planets
             // (docs/model.md, "The ISO mesh in the dynamic models").
             let s0 = m.sun_base_radius * (x[SUN] - x[CARRIER]);
             let half = 0.5 * m.backlash;
