@@ -138,3 +138,12 @@ def test_modal_analysis_of_a_scene_with_shafts_models_them(joints: str) -> None:
                         ({"inertias.motor_inertia": 0.01, "shafts.input": {"stiffness": 1e4}}, "sun angle")):
         m = modes(_with(RATED.replace(**shaft), joints))
         assert m.dof_names[-1] == name and m.part_names[-1] == "shafts"
+
+
+def test_a_scene_without_a_first_stage_reports_no_sun() -> None:
+    # model_info listed the default sun (2.02 kg) and its inertia in the sun's generalised mass
+    # for a scene whose stage1 is None.
+    info = RATED.replace(stage1=None).model_info()
+    assert info["sun_mass"] == 0.0 and info["sun_inertia"] == 0.0
+    assert info["generalized_mass"][2] == 0.0 and info["generalized_mass"][0] > 0.0
+    assert RATED.model_info()["sun_mass"] > 1.0

@@ -210,8 +210,9 @@ class Scene:
         """Mass properties the model uses (computed ones included) [kg, kg m^2], the
         generalised masses of the rigid model's (carrier, crank, sun, load, motor) [kg m^2] (the
         load and motor entries are coordinates only with ``shafts.output`` / ``shafts.input``;
-        without them the load inertia is in the carrier's and the motor inertia in the sun's),
-        crank radius [m], ratio and DOF count."""
+        without them the load inertia is in the carrier's and the motor inertia in the sun's;
+        a scene without a first stage has no sun: its mass and entry are 0), crank radius [m],
+        ratio and DOF count."""
         return dict(self._compiled.model_info())
 
     @property

@@ -195,8 +195,19 @@ fn model_info<'py>(py: Python<'py>, sc: &Scene) -> PyResult<Bound<'py, PyDict>> 
     let model = RigidModel::new(&sc.rigid_counterpart())?;
     let d = PyDict::new(py);
     let i = model.inertias;
+    // Without a first stage there is no sun: its coordinate stays in the model's vectors but
+    // carries nothing, so its mass is reported as zero rather than the default sun's.
+    let no_sun = sc.stage1.is_none();
+    let sun = if no_sun {
+        crate::geometry::mass::MassProperties {
+            mass: 0.0,
+            inertia: 0.0,
+        }
+    } else {
+        i.sun
+    };
     for (name, mp) in [
-        ("sun", i.sun),
+        ("sun", sun),
         ("crank", i.crank),
         ("disc", i.disc),
         ("carrier", i.carrier),
@@ -206,7 +217,11 @@ fn model_info<'py>(py: Python<'py>, sc: &Scene) -> PyResult<Bound<'py, PyDict>> 
     }
     d.set_item("load_inertia", i.load_inertia)?;
     d.set_item("motor_inertia", i.motor_inertia)?;
-    d.set_item("generalized_mass", model.mass.to_vec())?;
+    let mut mass = model.mass.to_vec();
+    if no_sun {
+        mass[crate::dynamics::model::rigid::SUN] = 0.0;
+    }
+    d.set_item("generalized_mass", mass)?;
     d.set_item("crank_radius", model.crank_radius)?;
     d.set_item("ratio", model.ratio)?;
     d.set_item("max_penetration", model.max_penetration)?;
