@@ -157,3 +157,13 @@ def test_a_load_reversal_within_a_few_fixed_steps_warns() -> None:
         simulate(Scene.paper("rated", load={"kind": "step", "before": 0.0, "after": rated, "time": 0.004}),
                  0.005, channels=["motion"])  # not a reversal
         simulate(Scene.paper("rated", load=step), 0.005, "dopri5", channels=["motion"])
+
+
+def test_a_fixed_step_run_beyond_the_step_budget_is_refused_before_it_starts() -> None:
+    # generalized-alpha at dt 1e-9 s over 0.3 s planned 3e8 steps (hours) although max_steps
+    # (default 1e8) bounds an adaptive run.
+    with pytest.raises(rvdyn.ParameterError, match=r"3\.000e8 steps, more than max_steps = 100000000"):
+        simulate(Scene.paper("rated"), 0.3, dt=1e-9)
+    with pytest.raises(rvdyn.ParameterError, match="max_steps = 10:"):
+        simulate(Scene.paper("rated"), 1e-3, "rk4", dt=1e-5, max_steps=10)
+    assert simulate(Scene.paper("rated"), 1e-3, "rk4", dt=1e-5, max_steps=100).ok  # exactly 100

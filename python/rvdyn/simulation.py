@@ -128,8 +128,10 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     step_check: what a fixed step that cannot be accurate for the scene does (fewer than 8 steps
     per pin-mesh period): ``"warn"`` (default, a ``RuntimeWarning``), ``"raise"``
     (:class:`rvdyn.ParameterError`) or ``"off"``.
-    h_min, max_steps: smallest step [s] (default 1e-13 s) and most steps (default 1e8) of an
-    adaptive integrator; beyond either the run stops with :class:`rvdyn.SimulationError`.
+    h_min, max_steps: smallest step [s] of an adaptive integrator (default 1e-13 s) and most
+    steps of any (default 1e8); beyond either an adaptive run stops with
+    :class:`rvdyn.SimulationError`, and a fixed step that would take more than ``max_steps`` is a
+    :class:`rvdyn.ParameterError` before the run.
 
     The core runs with the GIL released; Ctrl-C stops it cleanly (``KeyboardInterrupt``). A run
     that goes unstable raises :class:`rvdyn.SimulationError` saying when and what would help.

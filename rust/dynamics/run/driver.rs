@@ -160,6 +160,17 @@ impl SimOptions {
         if !self.method.0.adaptive {
             let dt = self.dt.unwrap_or_else(|| self.method.default_dt());
             let steps = self.t_end / dt;
+            // Whole steps, as the fixed clock takes them (t_end / dt can exceed a whole count
+            // by an ulp).
+            let whole = (steps * (1.0 - 1e-12)).ceil();
+            if whole > self.max_steps as f64 && self.max_steps as f64 <= MAX_STEPS {
+                // The step budget holds for the fixed-step methods too, before they start.
+                return Err(RvdynError::Parameter(format!(
+                    "dt = {dt:.3e} s over t_end = {:.3e} s would take {whole:.3e} steps, more \
+                     than max_steps = {}: raise max_steps (at most {MAX_STEPS:.0e}) or dt",
+                    self.t_end, self.max_steps
+                )));
+            }
             if steps > MAX_STEPS {
                 return Err(RvdynError::Parameter(format!(
                     "dt = {dt:.3e} s over t_end = {:.3e} s would take {steps:.2e} steps, more \
