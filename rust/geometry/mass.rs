@@ -216,7 +216,9 @@ mod tests {
     fn default_disc_matches_the_design_estimate() {
         let g = CycloidGeometry::new(paper_params()).unwrap();
         let mp = disc_mass_properties(&g, &DiscHoles::paper(), STEEL_DENSITY).unwrap();
-        // docs/model.md#default-scene: about 14.7 kg and 0.163 kg m^2.
+        // Plausibility against a hand estimate, a solid disc of radius rp - rrp less the same
+        // holes: 14.72 kg and 0.1628 kg m^2 (the exact value, 14.80 kg and 0.1649 kg m^2, is
+        // docs/model.md#default-scene's and tests/test_geometry.py checks it to 1e-8).
         assert!((mp.mass - 14.7).abs() < 0.15, "{mp:?}");
         assert!((mp.inertia - 0.163).abs() < 0.004, "{mp:?}");
     }
