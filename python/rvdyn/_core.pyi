@@ -22,6 +22,7 @@ __all__ = [
     "stiffness_maximum",
     "hertz_line_contact",
     "impact_force",
+    "roller_bearing_life",
     "PAPER_IMPACT_STIFFNESS",
     "PAPER_IMPACT_EXPONENT",
     "PAPER_IMPACT_MAX_DAMPING",

@@ -349,8 +349,8 @@ class Result:
             load = 0.5 * (mag[1:] + mag[:-1])
             total = rev.sum(axis=0)
             # ISO 281 per bearing in the core: (equivalent load, L10); the worst is the largest load.
-            lives = {j: _core.roller_bearing_life(rating, load[(slice(None), *j)].tolist(),
-                                                  rev[(slice(None), *j)].tolist())
+            lives = {j: _core.roller_bearing_life(rating, load[(slice(None),) + j].tolist(),
+                                                  rev[(slice(None),) + j].tolist())
                      for j in np.ndindex(*load.shape[1:])}
             worst = max(lives, key=lambda j: lives[j][0])
             p, l10 = lives[worst]
