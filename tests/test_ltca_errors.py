@@ -45,3 +45,24 @@ def test_assembly_errors_at_rigid_joints_are_refused() -> None:
     scene = Scene.paper("rated")
     with pytest.raises(rvdyn.SceneError):
         ltca(scene.replace(**{"errors.crank_eccentricity": [1e-6, 0.0, 0.0]}), None, [0.0])
+
+
+@pytest.mark.parametrize("modification", [{"cycloid.d_rrp": -0.0099}, {"cycloid.d_delta": 0.010 / 0.150},
+                                          {"cycloid.d_rrp": -0.002}])
+def test_a_profile_that_overlaps_the_pins_is_named_as_such(modification: dict[str, float]) -> None:
+    # At the accepted limits of the modifications the disc overlaps the pins by millimetres at
+    # the kinematic pose; the error used to advise reducing the torque or the clearances.
+    with pytest.raises(rvdyn.ConvergenceError, match=r"overlap by .* at the\s+kinematic pose.*cannot be assembled"):
+        ltca(Scene.paper(**modification), 4024.9, [0.0])
+    # Overlaps within the bound are preloads the equilibrium resolves.
+    assert ltca(Scene.paper(**{"cycloid.d_rrp": -2e-5}), 4024.9, [0.0]).torque_balance[0] < 1e-9
+
+
+def test_a_rated_torque_too_small_for_a_loop_names_the_rated_torque() -> None:
+    # The error used to name the loop's internal point next to zero (2e-7 N m) and advise a
+    # minimum the argument already exceeded.
+    from rvdyn.analysis import torque_twist
+
+    with pytest.raises(rvdyn.ParameterError, match=r"rated torque 2\.000e-5 N m is too small for a torque-twist loop"):
+        torque_twist(Scene.paper(), 2e-5, 0.0, 41)
+    assert torque_twist(Scene.paper(), 1e-4, 0.0, 41).rigidity > 0

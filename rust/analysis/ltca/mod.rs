@@ -570,10 +570,10 @@ impl Ltca {
                         q = q3;
                         r
                     }
-                    Err(_) => return Err(e),
+                    Err(_) => return Err(self.overlap_at_kinematic_pose(psi, torque, &kin_here, e)),
                 }
             }
-            Err(e) => return Err(e),
+            Err(e) => return Err(self.overlap_at_kinematic_pose(psi, torque, &kin_here, e)),
         };
         if self.history.len() == HISTORY {
             self.history.pop();
@@ -581,6 +581,37 @@ impl Ltca {
         self.history
             .insert(0, Solved::with_kinematic(psi, torque, q.clone(), &kin_here));
         Ok((q, rep))
+    }
+
+    /// `error`, or, where the contacts already overlap beyond the penetration bound at the
+    /// kinematic pose `kin` (a negative `d_rrp`, a large `d_delta` or oversized pins: no torque
+    /// resolves that), an error that says so. Newton's own message blames the torque or the
+    /// clearances, which at the accepted limits of the modifications is the wrong advice.
+    fn overlap_at_kinematic_pose(
+        &mut self,
+        psi: f64,
+        torque: f64,
+        kin: &[f64],
+        error: RvdynError,
+    ) -> RvdynError {
+        let st = &mut self.statics;
+        if st
+            .eval_fresh(psi, kin, torque, &mut self.work, true)
+            .is_err()
+        {
+            return error;
+        }
+        let (overlap, bound) = (st.max_penetration, st.model.max_penetration);
+        if overlap <= bound {
+            return error;
+        }
+        RvdynError::Convergence(format!(
+            "at crank angle {psi} rad the contacts overlap by {overlap:.3e} m already at the \
+             kinematic pose, beyond the bound of a tenth of the pin radius ({bound:.3e} m): the \
+             profile modification (a negative cycloid.d_rrp or a large cycloid.d_delta) or the pin \
+             errors make a disc that cannot be assembled with the pins; use modifications of tens \
+             of micrometres"
+        ))
     }
 
     /// The static equilibrium at crank angle `psi` \[rad\] under the output torque `torque`
@@ -1051,7 +1082,24 @@ impl Ltca {
         // Newton's round-off floor is that of the first turns (at a few hundred radians it
         // failed at the loop's near-zero torques); reported at the caller's.
         let reduced = psi.rem_euclid(self.te_window);
-        let mut out = self.twist_loop_reduced(rated, reduced, points, friction)?;
+        let mut out = self
+            .twist_loop_reduced(rated, reduced, points, friction)
+            .map_err(|e| match e {
+                // The torque Newton names is the loop's own point next to zero, not the
+                // caller's: say which, and what to raise.
+                RvdynError::Parameter(m) if m.contains("too small to resolve") => {
+                    RvdynError::Parameter(format!(
+                        "the rated torque {:.3e} N m is too small for a torque-twist loop: its \
+                         points next to zero torque, at {:.3e} N m (1e-7 of the rated torque, at \
+                         least 1e-3 N m, at most 1 % of it), are below the smallest torque an \
+                         equilibrium resolves; raise the rated torque to at least 100 times the \
+                         smallest torque named here: {m}",
+                        rated.abs(),
+                        zero_side_torque(rated.abs())
+                    ))
+                }
+                other => other,
+            })?;
         out.crank_angle = psi;
         Ok(out)
     }
