@@ -216,11 +216,13 @@ def test_friction_loop_agrees_with_slow_dynamic_runs() -> None:
     rate: it halves when the quarter doubles (checked), so the quasi-static twist is the
     extrapolation ``2 phi(0.04) - phi(0.02)`` (Richardson in the rate). Compared where the
     motion is quasi-static and sliding: loading branches from half the rated torque up,
-    unloading branches from 0.7 to 0.2 of it (near zero torque the bodies cross their
+    unloading branches from 0.6 to 0.2 of it (near zero torque the bodies cross their
     clearances dynamically; just after a reversal the regularisation creeps where the LTCA
-    sticks, over 10-20 % of the torque, less as the regularisation speed falls).
-    Measured: branches within 8.3e-5 of the tip twist (asserted 2e-4, the next term of the
-    rate expansion); widths at +-half rated 0.05 % and 0.3 % (asserted 1 %)."""
+    sticks, over 20-30 % of the torque, less as the regularisation speed falls: at 0.7 of the
+    torque, 0.3 after the reversal, the extrapolation is 2.3e-4 of the tip twist off and the
+    lag ratio 0.69).
+    Measured: branches within 4.5e-5 of the tip twist (asserted 2e-4, the next term of the
+    rate expansion); widths at +-half rated 0.06 % and 0.01 % (asserted 1 %)."""
     scene = rvdyn.Scene.physical("rated", friction={"pin": 0.05, "mesh": 0.05,
                                                     "regularisation_speed": 1e-4})
     loop = torque_twist(scene, RATED, 0.0, 41)
@@ -229,10 +231,10 @@ def test_friction_loop_agrees_with_slow_dynamic_runs() -> None:
     tip = float(loop.twist[10])
     s = loop.torque / RATED
     loading = np.r_[5:11, 25:31]
-    unloading = np.r_[13:19, 33:39]
+    unloading = np.r_[14:19, 34:39]
     compared = np.r_[loading, unloading]
     np.testing.assert_allclose(s[loading], np.r_[0.5:1.01:0.1, -0.5:-1.01:-0.1], atol=1e-12)
-    np.testing.assert_allclose(np.abs(s[unloading]), np.tile(np.r_[0.7:0.15:-0.1], 2), atol=1e-12)
+    np.testing.assert_allclose(np.abs(s[unloading]), np.tile(np.r_[0.6:0.15:-0.1], 2), atol=1e-12)
     lag_fast = fast[compared] - loop.twist[compared]
     lag_slow = slow[compared] - loop.twist[compared]
     # The lag is the damping's: it trails the load, and halves with the rate.

@@ -143,9 +143,10 @@ def test_iso_mesh_stiffness_takes_the_load_factor_below_100_N_per_mm() -> None:
 
 def test_bearing_static_rating_and_safety() -> None:
     """ISO 76: C0r = 44 (1 - D_we/D_pw) Z L_we D_we [N, mm] for one row of radial rollers, and
-    s0 = C0r / peak load. The physical preset's assumed bearings are past it at the rated load
-    (an outside review: s0 0.77 for the crank bearings), which bearing_life now says; at the
-    paper's load they are within it."""
+    s0 = C0r / peak load. The physical preset's bearings are sized for a static safety above 1
+    at the rated load (measured 1.21 eccentric, 1.29 crank, quasi-static peaks); its earlier
+    bearings (needles 5 x 30 mm, crank rollers 7 x 24 mm) were past it (an outside review:
+    s0 0.77 for the crank bearings), which bearing_life says with a warning."""
     import warnings
 
     rated = Scene.physical("rated")
@@ -155,17 +156,20 @@ def test_bearing_static_rating_and_safety() -> None:
         d, length, dpw, z = rl["diameter"] * 1e3, rl["length"] * 1e3, rl["pitch_diameter"] * 1e3, rl["count"]
         assert value == pytest.approx(44.0 * (1.0 - d / dpw) * z * length * d, rel=1e-12)
     r = simulate(rated, 0.03, progress=False)
-    with pytest.warns(RuntimeWarning) as caught:
-        life = r.bearing_life(t_start=0.01)  # (and a warning that the window is short)
-    assert any("ISO 76 static rating" in str(w.message) for w in caught)
-    assert life["crank"]["static_safety"] == pytest.approx(c0[1] / life["crank"]["peak_load"], rel=1e-12)
-    assert life["crank"]["static_safety"] < 1.0
-    light = simulate(Scene.physical("paper"), 0.03, progress=False)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        life = light.bearing_life(t_start=0.01)
+        life = r.bearing_life(t_start=0.01)  # (and a warning that the window is short)
     assert not [w for w in caught if "static rating" in str(w.message)]
-    assert min(v["static_safety"] for v in life.values()) > 1.0
+    for v in life.values():
+        assert v["static_safety"] > 1.0
+    assert life["crank"]["static_safety"] == pytest.approx(c0[1] / life["crank"]["peak_load"], rel=1e-12)
+    small = rated.replace(**{"joints.eccentric_bearing.rollers.length": 0.030,
+                             "joints.crank_bearing.rollers.length": 0.024})
+    r = simulate(small, 0.03, progress=False)
+    with pytest.warns(RuntimeWarning) as caught_small:
+        life = r.bearing_life(t_start=0.01)
+    assert any("ISO 76 static rating" in str(w.message) for w in caught_small)
+    assert life["crank"]["static_safety"] < 1.0
 
 
 def test_bearing_ratings_kind_is_checked() -> None:

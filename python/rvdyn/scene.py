@@ -109,7 +109,7 @@ class Scene:
         materials (``docs/model.md``, "The physical preset"): line-contact pins (Johnson, local
         profile curvature), ISO 6336-1 meshes varying along the line of action, needle and
         roller bearings built from their rollers with clearance (compliant joints),
-        stiffness-proportional damping with ratio 0.05 at 1670 Hz (the main torsional mode at
+        stiffness-proportional damping with ratio 0.05 at 1790 Hz (the main torsional mode at
         rated load; other modes in proportion to their frequency), and a 50 ms ramp from rest
         to the paper's input speed (use ``drive.start="step"`` with ``initial="steady"``).
 

@@ -19,12 +19,14 @@ pub const PHYSICAL_DAMPING_RATIO: f64 = 0.05;
 /// Reference frequency of the physical preset's damping \[Hz\]: its main torsional mode at rated
 /// load (linearised model, docs/model.md), so that this mode has the damping ratio
 /// [`PHYSICAL_DAMPING_RATIO`].
-pub const PHYSICAL_REFERENCE_FREQUENCY: f64 = 1670.0;
+pub const PHYSICAL_REFERENCE_FREQUENCY: f64 = 1790.0;
 
 /// Joints of the physical preset (assumed sizes, stated): on each eccentric a needle bearing
-/// in the 50 mm disc hole, 26 rollers of 5 mm x 30 mm on a 45 mm pitch diameter, 5 um radial
-/// clearance; each crankshaft in the carrier on two roller bearings lumped as one row of
-/// 20 rollers of 7 mm x 24 mm on a 50 mm pitch diameter, 5 um radial clearance. Roller damping
+/// in the 50 mm disc hole, 26 rollers of 5 mm x 36 mm on a 45 mm pitch diameter, 5 um radial
+/// clearance; each crankshaft in the carrier on two roller bearings of 20 rollers of
+/// 7 mm x 20 mm on a 50 mm pitch diameter, lumped as one row of 40 mm rollers, 5 um radial
+/// clearance. The lengths are chosen so that the ISO 76 static safety at rated load is above 1
+/// (about 1.2 and 1.3; docs/model.md, "Load rating, life and friction torque"). Roller damping
 /// as the contacts.
 ///
 /// # Example
@@ -34,7 +36,7 @@ pub const PHYSICAL_REFERENCE_FREQUENCY: f64 = 1670.0;
 /// let joints = physical_joints();
 /// let Joints::Compliant { eccentric_bearing, crank_bearing } = joints else { unreachable!() };
 /// let needles = eccentric_bearing.rollers.unwrap();
-/// assert_eq!((needles.count, needles.diameter, needles.length), (26, 0.005, 0.030)); // [m]
+/// assert_eq!((needles.count, needles.diameter, needles.length), (26, 0.005, 0.036)); // [m]
 /// assert_eq!(crank_bearing.unwrap().clearance, 5e-6); // [m]
 /// assert_eq!(Scene::physical("idle").unwrap().joints, joints);
 /// ```
@@ -52,13 +54,13 @@ pub fn physical_joints() -> Joints {
             stiffness: 0.0,
             damping: 0.0,
             clearance: 5e-6,
-            rollers: Some(rollers(26, 0.030, 0.005, 0.045)),
+            rollers: Some(rollers(26, 0.036, 0.005, 0.045)),
         },
         crank_bearing: Some(Bearing {
             stiffness: 0.0,
             damping: 0.0,
             clearance: 5e-6,
-            rollers: Some(rollers(20, 0.024, 0.007, 0.050)),
+            rollers: Some(rollers(20, 0.040, 0.007, 0.050)),
         }),
     }
 }
