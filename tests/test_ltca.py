@@ -152,6 +152,12 @@ def test_bad_input_is_a_clear_error() -> None:
         ltca(scene, 1e9, [0.1])
     with pytest.raises(rvdyn.ParameterError):
         ltca("paper", RATED, [0.0])  # type: ignore[arg-type]
+    # A count where angles belong (transmission_error takes a count) is refused, not solved at
+    # 360 rad; a float angle in a list is the way to one angle.
+    for count in (360, np.int64(90)):
+        with pytest.raises(rvdyn.ParameterError, match="not a count"):
+            ltca(scene, RATED, count)  # type: ignore[arg-type]
+    assert ltca(scene, RATED, [360.0]).crank_angle.tolist() == [360.0]
 
 
 def test_analyze_command_writes_figures_loads_and_summary(tmp_path: Path) -> None:

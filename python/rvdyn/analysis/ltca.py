@@ -457,6 +457,14 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
     if crank_angles is None:
         period = float(_core.LtcaSolver(sc._compiled, 1e-12).mesh_period)
         angles = period * np.arange(90) / 90.0
+    elif isinstance(crank_angles, (int, np.integer)):
+        # `ltca(scene, T, 360)` reads as "360 angles" (transmission_error takes a count there)
+        # but would be the single angle 360 rad.
+        raise ParameterError(
+            f"crank_angles = {crank_angles!r} is a whole number, not a list of angles: ltca takes crank "
+            "angles [rad], not a count; for n angles over the mesh period pass "
+            "np.arange(n) * period / n (period: LtcaResult.mesh_period of a default run), or omit "
+            "crank_angles for 90 of them; for one angle pass a float in a list, e.g. [0.0]")
     else:
         try:
             angles = np.atleast_1d(np.asarray(crank_angles, dtype=float))
