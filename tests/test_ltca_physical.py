@@ -74,11 +74,11 @@ def test_physical_both_directions_te_and_modifications() -> None:
     te = transmission_error(scene, RATED, rvdyn.analysis.tooth_mesh_angles(scene))
     pp = te.peak_to_peak()
     # Over the window after which the TE repeats (twelve mesh periods) the reverse TE is the
-    # forward one mirrored (psi -> window - psi): the same peak-to-peak (measured 5e-11
-    # relative loaded, 2e-10 unloaded), and the same from a grid four times finer (measured
-    # 1e-16 and 5e-10). Over one mesh period it is not (the roller sets fixed in the frame make
-    # the periods differ): forward 2.6085 / reverse 2.6134 arcsec, unloaded 0.085 / 0.170
-    # arcsec, against 2.6614 and 0.2035 over the window.
+    # forward one mirrored (psi -> window - psi): the same peak-to-peak (measured 3e-11
+    # relative loaded, 7e-10 unloaded), and the same from a grid four times finer (measured
+    # 3e-11 and 1.3e-9). Over one mesh period it is not (the roller sets fixed in the frame make
+    # the periods differ): forward 2.5655 / reverse 2.5832 arcsec, unloaded 0.086 / 0.171
+    # arcsec, against 2.6168 and 0.2048 over the window.
     assert te.periods == 12
     for key in ("forward", "unloaded_forward"):
         other = key.replace("forward", "reverse")
@@ -170,7 +170,7 @@ def test_fea_loads_balance_the_bearing_forces_in_the_disc_frame() -> None:
 
 def test_harmonics_warn_when_the_grid_cannot_read_the_sun_mesh() -> None:
     # At two angles per tooth-mesh cycle (tooth_mesh_angles, 84) the sun-mesh fundamental sits
-    # on the Nyquist bin and read 0.033 of its 0.96 arcsec, silently.
+    # on the Nyquist bin and read 0.072 of its 0.96 arcsec, silently.
     scene = Scene.physical("rated")
     te = transmission_error(scene, RATED, rvdyn.analysis.tooth_mesh_angles(scene), window=False)
     with pytest.warns(RuntimeWarning, match="sun mesh fundamental"):
@@ -219,7 +219,7 @@ def test_physical_bad_input_is_a_clear_error() -> None:
 def test_te_extremes_are_located_between_the_crank_angles() -> None:
     """The physical preset's TE peaks at the corner where an ISO mesh stiffness ramp ends
     (2.9e-3 rad of crank angle), so the samples' peak-to-peak converges only linearly in the
-    step (-1.7 % at 90 angles, -0.2 % at 2880). The refined extremes do not depend on the grid
+    step (-1.6 % at 90 angles, -0.02 % at 2880). The refined extremes do not depend on the grid
     they start from (90, 360 and 2880 angles: measured within 3.2e-9 (forward) and 2.5e-7
     (reverse: the nested search is greedy, and where two corners compete within a coarse step
     it can settle on the lower one, here 3e-12 rad lower) of the peak-to-peak loaded, 2e-6
@@ -262,7 +262,7 @@ def test_te_window_with_roller_sets_is_twelve_mesh_periods() -> None:
     the carrier has turned the assembly onto every roller set (docs/model.md, "Mesh period"):
     on the physical preset lcm(23/24, 23/20, 23/26) = 23/2 turns, twelve mesh periods. The TE
     at 0.3 rad plus the window equals that at 0.3 rad (measured below 1e-15 rad), plus one
-    mesh period it does not (measured 8.2e-8 rad, the roller-pass ripple); the paper preset
+    mesh period it does not (measured 6.1e-8 rad, the roller-pass ripple); the paper preset
     (rigid joints) repeats over its mesh period."""
     scene = Scene.physical("rated")
     te = transmission_error(scene, RATED, 84, window=False)
@@ -278,10 +278,10 @@ def test_te_window_with_roller_sets_is_twelve_mesh_periods() -> None:
 def test_te_harmonics_converge_and_their_uncertainty_bounds_the_aliasing() -> None:
     """The physical preset's TE has corners at the ends of the ISO ramps, so harmonics above
     half the grid fold onto the ones read: at 336 angles the sun-mesh harmonic (k = 42, 0.960
-    arcsec) reads 0.926 (-3.6 %); the half-grid uncertainty (0.114 arcsec there) bounds each
-    amplitude's error against 10 752 angles (measured for k = 42, 23, 6: 0.035, 9e-5, 4e-5
-    arcsec against 0.114, 2e-4, 1.3e-4); at 2688 angles the sun-mesh harmonics and the pin
-    pass are within 1 % (measured 0.17 %, 0.6 %, 4e-5)."""
+    arcsec) reads 0.900 (-6.3 %); the half-grid uncertainty (0.095 arcsec there) bounds each
+    amplitude's error against 10 752 angles (measured for k = 42, 23, 6: 0.060, 7e-5, 4e-5
+    arcsec against 0.095, 1.7e-4, 1.3e-4); at 2688 angles the sun-mesh harmonics and the pin
+    pass are within 1 % (measured 0.024 %, 0.09 %, 4e-5)."""
     scene = Scene.physical("rated")
     ref = {h.harmonic: h for h in transmission_error(scene, RATED, 10752, window=False).harmonics("forward", 400)}
     coarse = transmission_error(scene, RATED, 336, window=False).harmonics("forward", 5)

@@ -111,8 +111,8 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     (adaptive Dormand-Prince 5(4); ``atol`` [m] bounds displacement errors, default 1e-9 m;
     ``rtol`` relative velocity tolerance, default 1e-6) or ``"rk4"`` (fixed step ``dt``,
     default 1e-5 s). Without ``integrator``, ``options`` or ``dt``, a scene with roller bearings
-    (``Scene.physical``) runs dopri5 at atol 1e-8 m, rtol 1e-4 (``ROLLER_DEFAULT``: 3.9e-4 of the
-    peak pin force, where generalized-alpha at dt 1e-4 s is off by 3 %); other scenes
+    (``Scene.physical``) runs dopri5 at atol 1e-8 m, rtol 1e-4 (``ROLLER_DEFAULT``: 3.0e-4 of the
+    peak pin force over [0.05, 0.1] s from rest, where generalized-alpha at dt 1e-4 s is off by 3 %); other scenes
     generalized-alpha. ``atol`` is at most 1e-6 m and ``rtol`` at most 1e-2 (looser ones are a
     ``ParameterError``: the contact approaches are tens of micrometres).
     record_interval: sample spacing [s], at most ``t_end`` (default 1e-4 s, or ``t_end`` for

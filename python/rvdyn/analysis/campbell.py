@@ -124,7 +124,7 @@ def campbell(scene: Any, speeds: Sequence[float] | np.ndarray | None = None, *, 
     harmonics up to ``harmonics``. The default 8 is set by the ISO 6336 mesh stiffness: a
     rectangular wave between one and two tooth pairs, whose harmonics fall only as ``1/h``
     (4 and 7 are strong at the paper's contact ratio 1.63, and the 4th sun-mesh harmonic meets
-    the physical preset's main mode at 8488 deg/s, 2 % above the paper's input speed). A zero
+    the physical preset's main mode at 9116 deg/s, 9 % above the paper's input speed). A zero
     torque or power is a ``ParameterError``: unloaded contacts have no stiffness."""
     scene = _scene(scene)
     n_harmonics = _whole("harmonics", harmonics, 1, MAX_HARMONICS)

@@ -553,7 +553,7 @@ def transmission_error(scene: Scene, torque: float | None = None, points: int | 
     With roller bearings, whose roller sets stay fixed in the frame, the TE repeats only
     after several mesh periods (twelve on the physical preset: ``window``) and differs from
     period to period; one period alone can show a peak-to-peak far from the whole curve's (the
-    physical preset's unloaded TE: 0.085 arcsec over the first period, 0.204 over the window).
+    physical preset's unloaded TE: 0.086 arcsec over the first period, 0.205 over the window).
     The cost grows with the periods covered (about 1.5 s on the physical preset, 0.14 s for one
     period)."""
     sc = _scene(scene)
@@ -638,8 +638,8 @@ def running_friction(scene: Scene, torque: float | None = None, points: int | No
     """Quasi-static running sweeps with the scene's friction at ``points`` crank angles per
     mesh period (default: 24, or eight per tooth-mesh cycle of an ISO 6336 mesh or of tooth
     friction if that is more: the tooth sliding reverses at the pitch point, and two per cycle
-    fold its harmonics onto the mean, 0.9175-0.9233 with the start angle on the physical preset
-    at mu 0.05 against 0.9214-0.9218 at eight),
+    fold its harmonics onto the mean, 0.9169-0.9233 with the start angle on the physical preset
+    at mu 0.05 against 0.9211-0.9213 at eight),
     over one mesh period from ``start`` [rad] or (``window=True``) over the whole window after
     which everything repeats (``TransmissionError.window``): every contact slides as in the
     running reducer, the input driving against ``+torque`` (forward) and ``-torque``
@@ -650,8 +650,8 @@ def running_friction(scene: Scene, torque: float | None = None, points: int | No
     sweep divided by that with friction, ``mean(T_in,0) / mean(T_in)`` (docs/model.md, "Friction
     in the LTCA"). The frictionless sweep's work is the output work up to the elastic energy's
     change and the quadrature of the input torque's steps at the ISO mesh's zone changes; both
-    cancel in the quotient (1 without friction; the physical preset at mu 0.05 gives 0.9218 at
-    the default 336 angles, where ``T / (i mean(T_in))`` gave 0.906-0.925 over 24-336).
+    cancel in the quotient (1 without friction; the physical preset at mu 0.05 gives 0.9213 at
+    the default 336 angles, where ``T / (i mean(T_in))`` gave 0.904-0.924 over 24-336).
     Fewer than two angles per tooth-mesh cycle warn; a zero torque is a ``ParameterError``."""
     sc = _scene(scene)
     t = abs(_rated(sc, torque))
