@@ -992,7 +992,9 @@ fn a_chain_that_fails_from_the_kinematic_pose_continues_the_one_before() {
 /// The frictionless loop runs as two chains (the positive part in order, the negative part
 /// from its most loaded point outwards): the same bits on one thread as on two, and the same
 /// twist as the loop solved in order (the frictional loop's path with no friction, which
-/// `zero_friction_gives_the_closed_loop` also checks) to 1e-12 rad.
+/// `zero_friction_gives_the_closed_loop` also checks) to 1e-12 rad. That includes the first
+/// chain's second zero-torque point, which the two-chain loop takes from its first instead of
+/// solving it again along the path.
 #[test]
 fn the_two_chain_loop_is_the_same_on_any_thread_count() {
     let s = Scene::physical("rated").unwrap();
