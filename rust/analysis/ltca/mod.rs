@@ -1167,13 +1167,13 @@ impl Ltca {
                 // force evaluations on the physical preset (BENCHMARKS.md section 11.1).
                 let mut out: Vec<LoopPoint> = Vec::with_capacity(split);
                 for i in 0..split {
-                    let again = (torque[i] == 0.0)
-                        .then(|| {
-                            out.iter()
-                                .find(|p| torque[p.index] == 0.0 && sides[p.index] == sides[i])
-                        })
-                        .flatten()
-                        .cloned();
+                    let again = if torque[i] == 0.0 {
+                        out.iter()
+                            .find(|p| torque[p.index] == 0.0 && sides[p.index] == sides[i])
+                            .cloned()
+                    } else {
+                        None
+                    };
                     out.push(match again {
                         Some(p) => LoopPoint { index: i, ..p },
                         None => point(self, i)?,
