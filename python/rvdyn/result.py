@@ -38,6 +38,13 @@ def _describe(spec: dict[str, Any]) -> str:
 #: Channel name -> meaning, unit and shape (n = samples).
 CHANNELS: dict[str, str] = {name: _describe(spec) for name, spec in CHANNEL_SPECS.items()}
 
+#: The share of the loss ``W_in - W_out`` over an efficiency window above which the energy
+#: residual's change over the window makes :meth:`Result.efficiency` warn (sound runs: about
+#: 1e-6 of it; generalized-alpha at ``rho_inf`` 0.8 with contact damping 1e8 N s/m: 1.0).
+EFFICIENCY_BALANCE_SHARE = 0.01
+#: ... and the share of the input work below which the residual's change is not reported.
+EFFICIENCY_BALANCE_FLOOR = 1e-4
+
 _T = TypeVar("_T", bound=np.generic)
 
 
@@ -272,18 +279,37 @@ class Result:
         both works negative; before, that returned 1.08 for a reducer losing 8 %). Over whole
         crank revolutions (:meth:`steady_window`) the mesh cycles' ripple cancels. Needs the
         ``"energy"`` channels; ``ParameterError`` when no work flows or power flows out at both
-        ends."""
+        ends. A ``RuntimeWarning`` when the energy balance over the window is off by more than
+        1 % of the loss (and 1e-4 of the work): the integrator's error then shows in the
+        efficiency (``docs/model.md``, "Efficiency and the energy balance")."""
         i0 = int(np.searchsorted(self.t, self._steady_start(t_start)))
         w_in = float(self.input_work[-1] - self.input_work[i0])
         w_out = float(self.output_work[-1] - self.output_work[i0])
         if w_in == 0.0 or w_out == 0.0:
             raise ParameterError("no work flows through the reducer in the window: efficiency undefined")
+        if (w_in > 0.0) == (w_out > 0.0):
+            self._check_window_balance(i0, w_in, w_out)
         if w_in > 0.0 and w_out > 0.0:
             return w_out / w_in
         if w_in < 0.0 and w_out < 0.0:
             return w_in / w_out
         raise ParameterError(f"the reducer takes work at both ends (input {w_in:.4g} J, output {w_out:.4g} J "
                              "in the window, e.g. while it speeds up): efficiency undefined")
+
+    def _check_window_balance(self, i0: int, w_in: float, w_out: float) -> None:
+        # The residual E - E0 - W_in + W_out + D over the window bounds the integrator's error in
+        # the loss W_in - W_out: 1e-6 of it in sound runs, the whole loss when generalized-alpha
+        # at rho_inf 0.8 meets heavy damping (docs/model.md, "Efficiency and the energy balance").
+        drift = abs(float(self.energy_residual[-1] - self.energy_residual[i0]))
+        loss = abs(w_in - w_out)
+        if drift > EFFICIENCY_BALANCE_SHARE * loss and drift > EFFICIENCY_BALANCE_FLOOR * abs(w_in):
+            warnings.warn(
+                f"efficiency: the energy balance over the window is off by {drift:.4g} J, "
+                f"{100 * drift / max(loss, 1e-300):.3g} % of the loss ({loss:.4g} J), so the efficiency is "
+                f"uncertain by about {drift / abs(w_in):.2g}: the integrator does not resolve the scene's "
+                "velocity-dependent forces (heavy contact damping, a small friction.regularisation_speed); "
+                "with generalized-alpha use rho_inf=0 or a smaller dt, or use integrator=\"dopri5\"",
+                RuntimeWarning, stacklevel=3)
 
     def friction_power_means(self, t_start: float | None = None) -> dict[str, float]:
         """Mean friction power [W] per family (pins, teeth, bearings) from ``t_start`` [s]."""
