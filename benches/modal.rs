@@ -3,7 +3,7 @@
 //! eigen-analysis alone, and a Campbell diagram over 200 input speeds; the modes of the
 //! physical preset at one operating point (`modal/physical_16dof_point`).
 use criterion::{Criterion, criterion_group, criterion_main};
-use rvdyn::analysis::modal::{Linearizer, campbell, modal_analysis, modes_at};
+use rvdyn::analysis::modes::{Linearizer, campbell, modal_analysis, modes_at};
 use rvdyn::dynamics::Scene;
 use rvdyn::dynamics::model::compliant::default_joints;
 use std::hint::black_box;

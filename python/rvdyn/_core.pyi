@@ -524,7 +524,7 @@ class LtcaSolver:
     def friction_sweep(self, torque: float, crank_angles: list[float]) -> dict[str, Any]:
         """Running sweep with the scene's friction: TE [rad] and input torque [N m]."""
 
-# ---- vibration analyses (rust/python/modal.rs) ------------------------------------------------
+# ---- vibration analyses (rust/python/modes.rs) ------------------------------------------------
 
 def excitation_orders(scene_json: str, harmonics: int = 3) -> list[tuple[str, int, float, str]]:
     """Excitation orders of a scene as (name, harmonic, order, label), by increasing order."""

@@ -3,7 +3,7 @@
 pub mod efficiency;
 pub mod load_sharing;
 pub mod ltca;
-pub mod modal;
+pub mod modes;
 pub mod orders;
 pub mod pin_load_sharing;
 

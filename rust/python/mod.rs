@@ -14,7 +14,7 @@ mod errors;
 mod geometry;
 mod kinematics;
 mod ltca;
-mod modal;
+mod modes;
 mod scene;
 mod simulate;
 
@@ -43,6 +43,6 @@ fn rvdyn_core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scene::register(m)?;
     simulate::register(m)?;
     ltca::register(m)?;
-    modal::register(m)?;
+    modes::register(m)?;
     Ok(())
 }

@@ -24,7 +24,7 @@
 
 use crate::analysis::ltca::Ltca;
 use crate::analysis::ltca::statics::{CARRIER, Dense, Family, Kind, SUN, Statics, Work};
-use crate::analysis::modal::{LinearSystem, StiffnessPart};
+use crate::analysis::modes::{LinearSystem, StiffnessPart};
 use crate::dynamics::model::ReducerModel;
 use crate::dynamics::model::compliant::CompliantModel;
 use crate::dynamics::model::rigid::{FULL, LOAD, MOTOR, RigidModel, SUN as RSUN};

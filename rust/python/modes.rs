@@ -2,7 +2,7 @@
 //! over crank angle, Campbell diagrams (`python/rvdyn/analysis/{spectrum,modes,campbell}.py`
 //! wrap these private functions).
 
-use crate::analysis::modal::{Linearizer, ModalPoint, campbell, modes_at_state, modes_over};
+use crate::analysis::modes::{Linearizer, ModalPoint, campbell, modes_at_state, modes_over};
 use crate::analysis::orders::{ExcitationOrder, campbell_crossings, scene_orders};
 use crate::dynamics::scene::Scene;
 use numpy::IntoPyArray;
@@ -80,7 +80,7 @@ fn point_dict<'py>(py: Python<'py>, p: &ModalPoint) -> PyResult<Bound<'py, PyDic
         "omega_squared",
         a.modes.iter().map(|m| m.omega_squared).collect::<Vec<_>>(),
     )?;
-    let damped = |f: &dyn Fn(&crate::analysis::modal::DampedMode) -> f64, fallback: f64| {
+    let damped = |f: &dyn Fn(&crate::analysis::modes::DampedMode) -> f64, fallback: f64| {
         a.modes
             .iter()
             .map(|m| m.damped.as_ref().map_or(fallback, f))

@@ -1,7 +1,7 @@
 //! Modes of a reducer scene at an operating point, over a mesh period, and over the input
 //! speed (Campbell diagram).
 
-use crate::analysis::modal::{
+use crate::analysis::modes::{
     DampedTrack, Equilibrium, Linearizer, ModalAnalysis, modal_analysis_near,
 };
 use crate::analysis::orders::{Crossing, ExcitationOrder, campbell_crossings, scene_orders};
@@ -29,7 +29,7 @@ pub struct ModalPoint {
 /// # Example
 ///
 /// ```
-/// use rvdyn::analysis::modal::{Linearizer, modes_at};
+/// use rvdyn::analysis::modes::{Linearizer, modes_at};
 /// use rvdyn::dynamics::scene::Scene;
 /// // The paper's reducer with rigid joints: two modes (carrier and crank angle).
 /// let mut lin = Linearizer::new(&Scene::paper("paper").unwrap()).unwrap();
@@ -54,7 +54,7 @@ pub fn modes_at(lin: &mut Linearizer, torque: f64, crank_angle: f64) -> Result<M
 /// # Example
 ///
 /// ```
-/// use rvdyn::analysis::modal::{Linearizer, modes_over};
+/// use rvdyn::analysis::modes::{Linearizer, modes_over};
 /// use rvdyn::dynamics::scene::{PAPER_PRINTED_LOAD, Scene};
 /// let mut lin = Linearizer::new(&Scene::paper("paper").unwrap()).unwrap();
 /// let angles = [0.0, 0.1, 0.2, 0.3]; // crank angles [rad]
@@ -81,7 +81,7 @@ pub fn modes_over(
 }
 
 fn point(
-    sys: crate::analysis::modal::LinearSystem,
+    sys: crate::analysis::modes::LinearSystem,
     eq: Equilibrium,
     previous: Option<&DampedTrack>,
 ) -> Result<ModalPoint> {
@@ -140,7 +140,7 @@ pub struct Campbell {
 /// # Example
 ///
 /// ```
-/// use rvdyn::analysis::modal::campbell;
+/// use rvdyn::analysis::modes::campbell;
 /// use rvdyn::dynamics::scene::{PAPER_PRINTED_LOAD, Scene};
 /// use std::f64::consts::TAU;
 /// let scene = Scene::paper("paper").unwrap();
@@ -224,7 +224,7 @@ pub fn campbell(
 /// # Example
 ///
 /// ```
-/// use rvdyn::analysis::modal::{Linearizer, modes_at_state};
+/// use rvdyn::analysis::modes::{Linearizer, modes_at_state};
 /// use rvdyn::dynamics::run::driver::{RunControl, SimOptions, simulate};
 /// use rvdyn::dynamics::scene::Scene;
 /// use rvdyn::solve::Method;
