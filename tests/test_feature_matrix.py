@@ -21,6 +21,10 @@ import rvdyn
 from rvdyn import Scene
 from rvdyn.analysis import running_friction, torque_twist, transmission_error
 
+# The rated load's step at t = 0 overloads the bearings for a moment (simulate warns; tested
+# in test_physical.py::test_bearing_static_rating_and_safety); not what these tests look at.
+START_IMPACT = "the (eccentric|crank) bearings' load reaches"
+
 RATED = 43_921.3
 
 
@@ -85,9 +89,11 @@ def test_every_analysis_accepts_every_valid_scene(variant: str, analysis: str) -
 def steady_runs() -> dict[str, rvdyn.Result]:
     # Whole crank revolutions after the default 20 % start need about 0.14 s at the paper's
     # speed; a steady start with a step drive (the physical preset ramps from rest).
-    return {v: rvdyn.simulate(s.replace(**{"initial": "steady", "drive.start": "step"}), 0.15,
-                              record_interval=2e-4)
-            for v, s in VARIANTS.items()}
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=START_IMPACT, category=RuntimeWarning)
+        return {v: rvdyn.simulate(s.replace(**{"initial": "steady", "drive.start": "step"}), 0.15,
+                                  record_interval=2e-4)
+                for v, s in VARIANTS.items()}
 
 
 def _result_methods(r: rvdyn.Result, tmp: Any) -> dict[str, Callable[[], Any]]:

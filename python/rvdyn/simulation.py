@@ -85,6 +85,31 @@ def _warn(stats: dict[str, Any]) -> None:
         warnings.warn(message, RuntimeWarning, stacklevel=3)
 
 
+def _warn_static_overload(scene: Scene, res: Result) -> None:
+    """Warn when a roller bearing's recorded load exceeds its ISO 76 static rating ``C0r``
+    (static safety ``s0 < 1``): the raceways would yield there (permanent deformation above 1e-4
+    of the roller diameter), and the elastic roller law, the forces after it and the life do not
+    hold (docs/model.md, "Load rating, life and friction torque")."""
+    if "bearings" not in res.options.get("channels", ()) or len(res.t) == 0:
+        return
+    ratings = scene._compiled.bearing_ratings("static")
+    for name, c0, key in (("eccentric", ratings[0], "eccentric_bearing_force"),
+                          ("crank", ratings[1], "crank_bearing_force")):
+        if c0 is None:
+            continue
+        load = np.linalg.norm(getattr(res, key), axis=-1).reshape(len(res.t), -1).max(axis=1)
+        k = int(np.argmax(load))
+        if load[k] > c0:
+            warnings.warn(
+                f"the {name} bearings' load reaches {load[k] / 1e3:.1f} kN at t = {res.t[k]:.4g} s, above "
+                f"their ISO 76 static rating C0r = {c0 / 1e3:.1f} kN (static safety s0 = {c0 / load[k]:.2f} < 1): "
+                "the raceways would yield, and the elastic roller law and the forces do not hold there. The "
+                "presets apply their load as a step at t = 0 (also with initial=\"steady\"), which gives "
+                "such a peak: ramp the load over a few periods of the main torsional mode, e.g. "
+                "load={\"kind\": \"table\", \"points\": [[0, 0], [0.02, torque]]} (rated physical preset: "
+                "155 kN peak, s0 1.18), or use larger bearings (joints.*.rollers)", RuntimeWarning, stacklevel=3)
+
+
 def _t_end(t_end: object) -> float:
     if isinstance(t_end, bool):
         raise ParameterError(f"t_end must be a time in s, got {_short(t_end)}")
@@ -152,7 +177,9 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     used = opts.resolved(t)
     arrays, stats = _core.simulate(scene._compiled, t, opts, progress=bool(progress))
     _warn(stats)
-    return Result(arrays, stats, scene.to_dict(), used)
+    res = Result(arrays, stats, scene.to_dict(), used)
+    _warn_static_overload(scene, res)
+    return res
 
 
 def _grid(base: Scene, grid: Mapping[str, Iterable[Any]]) -> tuple[list[Scene], list[dict[str, Any]]]:
@@ -243,5 +270,7 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
             else:
                 arrays, stats = item
                 _warn(stats)
-                results[i] = Result(arrays, stats, scene.to_dict(), run_options)
+                done = Result(arrays, stats, scene.to_dict(), run_options)
+                _warn_static_overload(scene, done)
+                results[i] = done
     return [r for r in results if r is not None]

@@ -286,11 +286,12 @@ mod tests {
     #[test]
     fn fc_by_hand() {
         // gamma = 0.1: 0.1^(2/9) = 0.599484, 0.9^(29/27) = 0.893 029, 1.1^(-1/4) = 0.976 454,
-        // (0.9/1.1)^(143/108) = 0.766 668, (1.04 * 0.766 668)^4.5 = 0.360 694,
-        // 1.360 694^(-2/9) = 0.933 826:
-        // f_c = 207.9 * 0.83 * 0.599484 * 0.893029 * 0.976454 * 0.933826 = 84.19.
+        // (0.9/1.1)^(143/108) = 0.766 668, (1.04 * 0.766 668)^4.5 = 0.360 897,
+        // 1.360 897^(-2/9) = 0.933 826:
+        // f_c = 207.9 * 0.83 * 0.599484 * 0.893029 * 0.976454 * 0.933826 = 84.235 (84.232
+        // from the unrounded factors; ISO 281 tabulates 84.2 at gamma 0.1).
         let fc = fc_line_contact(0.1).unwrap();
-        assert!(close(fc, 84.19, 1e-3), "{fc}");
+        assert!(close(fc, 84.232, 1e-5), "{fc}");
         assert!(fc_line_contact(0.0).is_err());
         assert!(fc_line_contact(1.0).is_err());
     }
@@ -313,7 +314,7 @@ mod tests {
             * 14f64.powf(0.75)
             * 8f64.powf(29.0 / 27.0);
         assert!(close(c, by_hand, 1e-14));
-        // 84.19 * 1.1 * 10.27 * 7.24 * 9.33: about 64 kN, the size class of a needle bearing
+        // 84.23 * 1.1 * 10.27 * 7.24 * 9.33: about 64 kN, the size class of a needle bearing
         // with 14 rollers of 8 x 20 mm.
         assert!(c > 55e3 && c < 75e3, "{c}");
         // Doubling the rows multiplies by 2^(7/9).

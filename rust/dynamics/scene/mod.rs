@@ -292,6 +292,18 @@ pub struct Bearing {
     pub rollers: Option<Rollers>,
 }
 
+/// The largest roller length and diameter a scene accepts \[m\]: a larger value is a length in
+/// millimetres.
+pub const MAX_ROLLER_SIZE: f64 = 1.0;
+
+/// The largest radial clearance per side of a roller bearing, as a share of its pitch
+/// diameter: ISO 5753's largest clearance groups stay below about 2e-3 of the bore.
+pub const MAX_CLEARANCE_SHARE: f64 = 0.01;
+
+/// The largest Palmgren load factor `f1` a scene accepts: roller bearings have 1e-4 to 1e-3
+/// (Palmgren 1959; Harris and Kotzalas 2007, section 7.3).
+pub const MAX_PALMGREN_F1: f64 = 1e-2;
+
 /// The rollers of a roller bearing (SI).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -368,6 +380,28 @@ impl Rollers {
             return bad(format!(
                 "diameter {} m must be below pitch_diameter {} m",
                 self.diameter, self.pitch_diameter
+            ));
+        }
+        // A metre-long roller is a length typed in millimetres (36 for 36 mm gave a 21 MN
+        // rating without a word).
+        for (n, v) in [("length", self.length), ("diameter", self.diameter)] {
+            if v > MAX_ROLLER_SIZE {
+                return bad(format!(
+                    "{n} is in m and at most {MAX_ROLLER_SIZE} m, got {v} m (a value in mm? \
+                     36 mm is 0.036 m)"
+                ));
+            }
+        }
+        // The rollers must fit side by side on their pitch circle (full complement at most).
+        let circle = std::f64::consts::PI * self.pitch_diameter;
+        if f64::from(self.count) * self.diameter >= circle {
+            return bad(format!(
+                "{} rollers of diameter {} m do not fit on the pitch circle of {} m: count x \
+                 diameter = {:.4e} m must be below pi x pitch_diameter = {circle:.4e} m",
+                self.count,
+                self.diameter,
+                self.pitch_diameter,
+                f64::from(self.count) * self.diameter
             ));
         }
         if !(self.damping_ratio.is_finite() && (0.0..1.0).contains(&self.damping_ratio)) {
@@ -664,6 +698,13 @@ impl Friction {
                 if !(x.is_finite() && x >= 0.0) {
                     return bad(format!("friction.bearing.{n} must be >= 0, got {x}"));
                 }
+            }
+            if b.f1 > MAX_PALMGREN_F1 {
+                return bad(format!(
+                    "friction.bearing.f1 is Palmgren's load factor, 1e-4 to 1e-3 for roller \
+                     bearings, at most {MAX_PALMGREN_F1}; got {}",
+                    b.f1
+                ));
             }
             // 1e-2 m^2/s is 10 000 cSt, thicker than any bearing oil at its running
             // temperature (ISO VG 1000 has 1000 cSt at 40 C): a larger value is a unit mistake.

@@ -483,8 +483,8 @@ pub static FIELDS: &[Field] = &[
         "number",
         "m",
         ZERO,
-        ">= 0",
-        "radial clearance",
+        ">= 0; with rollers, at most 1 % of their pitch diameter",
+        "radial clearance per side (half the ISO 5753 radial internal clearance)",
     ),
     f(
         "joints.eccentric_bearing.rollers",
@@ -510,7 +510,7 @@ pub static FIELDS: &[Field] = &[
         "number",
         "m",
         REQ,
-        "> 0",
+        "> 0, <= 1 m",
         "effective roller length",
     ),
     f(
@@ -519,7 +519,7 @@ pub static FIELDS: &[Field] = &[
         "number",
         "m",
         REQ,
-        "> 0, < pitch_diameter",
+        "> 0, < pitch_diameter, <= 1 m; count x diameter < pi x pitch_diameter",
         "roller diameter (ISO 281 load rating)",
     ),
     f(
@@ -582,8 +582,8 @@ pub static FIELDS: &[Field] = &[
         "number",
         "m",
         ZERO,
-        ">= 0",
-        "radial clearance",
+        ">= 0; with rollers, at most 1 % of their pitch diameter",
+        "radial clearance per side (half the ISO 5753 radial internal clearance)",
     ),
     f(
         "joints.crank_bearing.rollers",
@@ -609,7 +609,7 @@ pub static FIELDS: &[Field] = &[
         "number",
         "m",
         REQ,
-        "> 0",
+        "> 0, <= 1 m",
         "effective roller length",
     ),
     f(
@@ -618,7 +618,7 @@ pub static FIELDS: &[Field] = &[
         "number",
         "m",
         REQ,
-        "> 0, < pitch_diameter",
+        "> 0, < pitch_diameter, <= 1 m; count x diameter < pi x pitch_diameter",
         "roller diameter (ISO 281 load rating)",
     ),
     f(
@@ -899,7 +899,7 @@ pub static FIELDS: &[Field] = &[
         "number",
         "-",
         REQ,
-        ">= 0",
+        ">= 0, <= 0.01",
         "Palmgren load factor",
     ),
     f(

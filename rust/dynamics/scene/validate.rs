@@ -180,6 +180,16 @@ impl Scene {
                 }
                 if let Some(r) = &b.rollers {
                     r.check(&format!("joints.{n}"))?;
+                    let most = super::MAX_CLEARANCE_SHARE * r.pitch_diameter;
+                    if b.clearance > most {
+                        return err(format!(
+                            "joints.{n}.clearance is the radial clearance per side in m (half the \
+                             ISO 5753 radial internal clearance), at most {} of the rollers' \
+                             pitch diameter, {most:.3e} m; got {} m",
+                            super::MAX_CLEARANCE_SHARE,
+                            b.clearance
+                        ));
+                    }
                     if !(b.stiffness.is_finite()
                         && b.stiffness >= 0.0
                         && b.damping.is_finite()
