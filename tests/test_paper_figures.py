@@ -93,7 +93,7 @@ def test_thinned_figure_covers_the_same_pixel_columns_as_the_full_traces(short_r
 
     def render(thin: bool):
         fig = draw("rated", paper._theory(scene), result)
-        fig.tight_layout()
+        paper._fixed_layout(fig)
         points = sum(len(line.get_xdata()) for ax in fig.axes for line in ax.get_lines())
         if thin:
             paper._thin_lines(fig)
@@ -119,6 +119,34 @@ def test_thinned_figure_covers_the_same_pixel_columns_as_the_full_traces(short_r
     if name == "disc_center":
         path = fig.axes[1].get_lines()[0]
         assert len(path.get_xdata()) == len(result.t)
+
+
+@pytest.fixture(scope="module")
+def idle_run() -> tuple[rvdyn.Scene, rvdyn.Result]:
+    # Idle: contact forces below 1 N and a ripple of 1e-1 deg/s, the smallest numbers a
+    # paper figure shows.
+    scene = rvdyn.Scene.paper("idle")
+    return scene, rvdyn.simulate(scene, 0.5, progress=False, channels=list(paper.PAPER_CHANNELS))
+
+
+@pytest.mark.parametrize("load", ["idle", "rated"])
+@pytest.mark.parametrize("name", list(paper.FIGURES))
+def test_fixed_layout_keeps_every_label_inside_the_figure_and_off_the_other_axes(
+        short_run, idle_run, load, name) -> None:
+    # The paper figures are laid out with fixed margins, not by measuring their labels
+    # (tight_layout): every axes' labels, tick labels, offset texts, title and legend must still
+    # fall inside the figure and clear of the neighbouring axes.
+    scene, result = idle_run if load == "idle" else short_run
+    fig = paper.FIGURES[name][0](load, paper._theory(scene), result)
+    paper._fixed_layout(fig)
+    renderer = fig.canvas.get_renderer()
+    width, height = fig.bbox.width, fig.bbox.height
+    for ax in fig.axes:
+        box = ax.get_tightbbox(renderer)
+        assert box.x0 >= 0 and box.y0 >= 0 and box.x1 <= width and box.y1 <= height, (name, ax.get_title(), box)
+        for other in fig.axes:
+            if other is not ax:
+                assert not box.overlaps(other.bbox), (name, ax.get_title(), other.get_title())
 
 
 def test_thin_lines_keeps_first_last_and_extremes_of_every_pixel_column() -> None:

@@ -192,17 +192,27 @@ def _new_figure(figsize: tuple[float, float], ncols: int = 1) -> tuple[Any, Any]
     return fig, fig.subplots(1, ncols)
 
 
+#: Margins [in] around the axes of the paper figures: left (tick labels and y label), right,
+#: bottom (tick labels and x label), top (title), and the gap between axes side by side. Fixed
+#: instead of matplotlib's tight layout, which measures every tick label once more and took
+#: 35-45 % of the drawing time; wide enough for every figure and load case (tested).
+MARGINS_IN = {"left": 0.85, "right": 0.2, "bottom": 0.55, "top": 0.35, "gap": 1.0}
+
+
+def _fixed_layout(fig: Any) -> None:
+    """Place the axes of ``fig`` (in a row) with the margins :data:`MARGINS_IN`."""
+    w, h = fig.get_size_inches()
+    m = MARGINS_IN
+    n = len(fig.axes)
+    axes_w = (w - m["left"] - m["right"] - (n - 1) * m["gap"]) / n
+    fig.subplots_adjust(left=m["left"] / w, right=1 - m["right"] / w, bottom=m["bottom"] / h,
+                        top=1 - m["top"] / h, wspace=m["gap"] / axes_w)
+
+
 def _save(fig: Any, path: Path) -> None:
-    """Lay ``fig`` out (tight), thin its long traces to its pixels and write it as PNG."""
-    # The layout does not depend on the lines' data (they are clipped to their axes, and the
-    # axes limits are already set), but it places the legends, and a legend at loc="best"
-    # searches every vertex: during the layout the long traces hold their two end points only.
-    traces = _long_traces(fig)
-    for line, x, y in traces:
-        line.set_data(x[[0, -1]], y[[0, -1]])
-    fig.tight_layout()
-    for line, x, y in traces:
-        line.set_data(x, y)
+    """Lay ``fig`` out (:func:`_fixed_layout`), thin its long traces to its pixels and write it
+    as PNG."""
+    _fixed_layout(fig)
     _thin_lines(fig)  # the traces hold 50 000 samples; a figure is ~1000 pixels wide
     fig.savefig(path, dpi=DPI, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
 

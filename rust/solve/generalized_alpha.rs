@@ -260,6 +260,14 @@ impl GeneralizedAlpha {
         }
     }
 
+    /// The state's time moved from `from` to `to` (a fixed-step clock setting it to `k h`,
+    /// within an ulp of the running sum): the pseudo-acceleration made at `from` goes with it.
+    pub fn retime(&mut self, from: f64, to: f64) {
+        if self.p_t == from {
+            self.p_t = to;
+        }
+    }
+
     /// Forget the pseudo-acceleration: the next step starts it again from the acceleration
     /// (after an impact, where its history says nothing about the next step).
     pub fn restart(&mut self) {
@@ -519,7 +527,9 @@ struct GeneralizedAlphaRun {
 impl Integrator for GeneralizedAlphaRun {
     fn advance(&mut self, sys: &dyn MechanicalSystem, st: &mut State, _t_end: f64) -> Result<()> {
         self.stepper.step(sys, st, self.clock.h)?;
+        let t = st.t;
         self.clock.tick(st);
+        self.stepper.retime(t, st.t);
         Ok(())
     }
 
