@@ -400,7 +400,7 @@ def _add_paper(p: argparse.ArgumentParser) -> None:
     p.add_argument("--integrator", default=None, metavar="NAME", choices=INTEGRATORS,
                    help="time integrator"
                    + (f": one of {', '.join(INTEGRATORS)}" if INTEGRATORS else "")
-                   + " (default: the library's choice)")
+                   + " (default: the scene's own, dopri5 for the idle case and generalized-alpha for the loaded ones)")
 
 
 def _run_paper(args: argparse.Namespace) -> int:
