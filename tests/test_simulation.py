@@ -272,8 +272,14 @@ def test_the_default_integrator_of_an_idle_scene_resolves_its_rattle() -> None:
     assert (default.options["atol"], default.options["rtol"]) == (1e-11, 1e-9)
     ref = _idle_statistics(simulate(scene, 1.0, "dopri5", atol=1e-13, rtol=1e-11, **kw))
     np.testing.assert_allclose(_idle_statistics(default), ref, rtol=0.02)
-    fixed = _idle_statistics(simulate(scene, 1.0, "generalized-alpha", **kw))
+    # Asked for by name, generalized-alpha is reported (a RuntimeWarning, or an error by option).
+    with pytest.warns(RuntimeWarning, match="idle scene started from rest"):
+        fixed = _idle_statistics(simulate(scene, 1.0, "generalized-alpha", **kw))
     assert fixed[2] > 3 * ref[2] and fixed[4] > 3 * ref[4]
+    with pytest.raises(rvdyn.ParameterError, match="dt <= 2e-5 s"):
+        simulate(scene, 1e-3, "generalized-alpha", step_check="raise", **kw)
+    with pytest.warns(RuntimeWarning, match="generalized-alpha-adaptive on an idle scene"):
+        simulate(scene, 1e-3, "generalized-alpha-adaptive", **kw)
     # A sweep of idle scenes gets the same default; a mixed one keeps each scene's own.
     runs = rvdyn.sweep([scene, Scene.paper("rated")], 1e-3, channels=["motion"])
     assert [r.options["integrator"] for r in runs] == ["dopri5", "generalized-alpha"]

@@ -170,8 +170,9 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     skip_separated: skip the exact gap query of pins that provably cannot touch (a Lipschitz
     bound on the gap from the last exact query and the disc's motion since); the answer is the
     same either way, ``False`` exists to measure the saving.
-    step_check: what a fixed step that cannot be accurate for the scene does (fewer than 8 steps
-    per pin-mesh period): ``"warn"`` (default, a ``RuntimeWarning``), ``"raise"``
+    step_check: what a step that cannot be accurate for the scene does (fewer than 8 steps
+    per pin-mesh period; generalized-alpha above 2e-5 s, or its adaptive form, on an idle scene
+    from rest): ``"warn"`` (default, a ``RuntimeWarning``), ``"raise"``
     (:class:`rvdyn.ParameterError`) or ``"off"``.
     h_min, max_steps: smallest step [s] of an adaptive integrator (default 1e-13 s) and most
     steps of any (default 1e8); beyond either an adaptive run stops with
