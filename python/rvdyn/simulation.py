@@ -56,13 +56,14 @@ def _resolve_options(options: Options | None, integrator: str | None, changes: d
 ROLLER_DEFAULT: dict[str, Any] = {"integrator": "dopri5", "atol": 1e-8, "rtol": 1e-4}
 
 
-#: The default integrator of an idle scene (no load torque) without roller bearings. Its forces
+#: The default integrator of an idle scene (no load torque), with or without roller bearings. Its forces
 #: are a decaying rattle of a few newtons and less (about 7e-8 m of mesh deflection over the
 #: second half of a 1 s run, against 9e-5 m at rated load), which generalized-alpha at dt 1e-4 s
 #: does not resolve: over [0.5, 1] s its mesh-force and input-torque RMS are 12 times the
 #: converged values, and the error-controlled generalized-alpha at atol 1e-9 m has pin forces
 #: 2.4 times theirs. dopri5 at atol 1e-11 m, rtol 1e-9 is within 0.5 % of a run at 1e-13 m,
-#: 1e-11 in every force statistic (docs/validation.md, "Idle").
+#: 1e-11 in every force statistic (docs/validation.md, "Idle rattle"). On the physical preset
+#: ``ROLLER_DEFAULT`` put the idle peak pin force 62 % too high over [0.25, 0.5] s; this, 1.2 %.
 IDLE_DEFAULT: dict[str, Any] = {"integrator": "dopri5", "atol": 1e-11, "rtol": 1e-9}
 
 
@@ -83,10 +84,10 @@ def _scene_defaults(scenes: Sequence[Scene], options: Options | None, integrator
     bearings, ``IDLE_DEFAULT`` when every scene is idle, the library's defaults otherwise."""
     if options is not None or integrator is not None or changes.get("dt") is not None:
         return integrator, changes
-    if any(_has_rollers(s) for s in scenes):
-        default = ROLLER_DEFAULT
-    elif scenes and all(_is_idle(s) for s in scenes):
+    if scenes and all(_is_idle(s) for s in scenes):
         default = IDLE_DEFAULT
+    elif any(_has_rollers(s) for s in scenes):
+        default = ROLLER_DEFAULT
     else:
         return integrator, changes
     out = dict(changes)
@@ -156,7 +157,7 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     default 1e-5 s). Without ``integrator``, ``options`` or ``dt``, a scene with roller bearings
     (``Scene.physical``) runs dopri5 at atol 1e-8 m, rtol 1e-4 (``ROLLER_DEFAULT``: 3.0e-4 of the
     peak pin force over [0.05, 0.1] s from rest, where generalized-alpha at dt 1e-4 s is off by 3 %); an idle
-    scene without them (load kind ``"idle"``) runs dopri5 at atol 1e-11 m, rtol 1e-9 (``IDLE_DEFAULT``: its
+    scene (load kind ``"idle"``, with or without them) runs dopri5 at atol 1e-11 m, rtol 1e-9 (``IDLE_DEFAULT``: its
     rattle of a few newtons needs that; generalized-alpha at dt 1e-4 s has mesh forces 12 times too
     large in it); other scenes generalized-alpha. ``atol`` is at most 1e-6 m and ``rtol`` at most 1e-2 (looser ones are a
     ``ParameterError``: the contact approaches are tens of micrometres).
@@ -260,12 +261,12 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
              "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated,
              "step_check": step_check, "h_min": h_min, "max_steps": max_steps}
     t = _t_end(t_end)
-    # Each scene gets the defaults simulate would give it: scenes with roller bearings, idle
-    # scenes without them and the others run as groups, each with its own defaults.
+    # Each scene gets the defaults simulate would give it: idle scenes, scenes with roller
+    # bearings and the others run as groups, each with its own defaults.
     groups: dict[tuple[bool, bool], list[int]] = {}
     for i, s in enumerate(scene_list):
-        rollers = _has_rollers(s)
-        groups.setdefault((rollers, not rollers and _is_idle(s)), []).append(i)
+        idle = _is_idle(s)
+        groups.setdefault((idle, not idle and _has_rollers(s)), []).append(i)
     plans = []
     for idx in groups.values():
         integ, changes = _scene_defaults([scene_list[i] for i in idx], options, integrator, given)

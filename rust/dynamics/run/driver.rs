@@ -515,7 +515,8 @@ pub fn fixed_step_warnings(scene: &Scene, opt: &SimOptions) -> Result<Vec<String
 pub const IDLE_RATTLE_STEP: f64 = 2e-5;
 
 /// Why generalized-alpha cannot resolve the rattle of an idle scene started from rest (empty
-/// otherwise, and for scenes with roller bearings, whose idle rattle has not been checked):
+/// otherwise, and for scenes with roller bearings, whose idle rattle has not been measured with
+/// generalized-alpha):
 /// the fixed step above [`IDLE_RATTLE_STEP`], the error-controlled one at every tolerance
 /// checked (mesh forces 50-110 % off at atol 1e-10 to 1e-11 m, 650 % at 1e-9 m). The
 /// default integrator of such a scene (Python `IDLE_DEFAULT`) is dopri5 at atol 1e-11 m,
