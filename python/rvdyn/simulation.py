@@ -61,7 +61,7 @@ ROLLER_DEFAULT: dict[str, Any] = {"integrator": "dopri5", "atol": 1e-8, "rtol": 
 #: second half of a 1 s run, against 9e-5 m at rated load), which generalized-alpha at dt 1e-4 s
 #: does not resolve: over [0.5, 1] s its mesh-force and input-torque RMS are 12 times the
 #: converged values, and the error-controlled generalized-alpha at atol 1e-9 m has pin forces
-#: 2.4 times theirs. dopri5 at atol 1e-11 m, rtol 1e-9 is within 0.5 % of a run at 1e-13 m,
+#: 3.4 times theirs (RMS). dopri5 at atol 1e-11 m, rtol 1e-9 is within 0.5 % of a run at 1e-13 m,
 #: 1e-11 in every force statistic (docs/validation.md, "Idle rattle"). On the physical preset
 #: ``ROLLER_DEFAULT`` put the idle peak pin force 62 % too high over [0.25, 0.5] s; this, 1.2 %.
 IDLE_DEFAULT: dict[str, Any] = {"integrator": "dopri5", "atol": 1e-11, "rtol": 1e-9}
