@@ -448,12 +448,7 @@ pub fn fixed_step_warnings(scene: &Scene, opt: &SimOptions) -> Result<Vec<String
         return Ok(Vec::new());
     }
     let s = opt.settings();
-    // The step the fixed clock takes: t_end in whole steps of at most dt.
-    let dt = if s.t_end.is_finite() && s.t_end > 0.0 {
-        crate::solve::integrator::FixedClock::new(s.t_end, s.dt).h
-    } else {
-        s.dt
-    };
+    let dt = clock_step(&s);
     let name = opt.method.name();
     let mut out = Vec::new();
     if let crate::dynamics::scene::Drive::Speed { speed, .. } = scene.drive {
@@ -508,6 +503,15 @@ pub fn fixed_step_warnings(scene: &Scene, opt: &SimOptions) -> Result<Vec<String
     Ok(out)
 }
 
+/// The step a fixed-step run takes \[s\]: `t_end` in whole steps of at most `dt`.
+fn clock_step(s: &Settings) -> f64 {
+    if s.t_end.is_finite() && s.t_end > 0.0 {
+        crate::solve::integrator::FixedClock::new(s.t_end, s.dt).h
+    } else {
+        s.dt
+    }
+}
+
 /// Longest generalized-alpha step that resolves an idle scene's rattle \[s\]: on the paper scene
 /// from rest, dt 2e-5 s is within 1 % of a converged run in the force statistics over
 /// [0.5, 1] s, 5e-5 s within 4 %, 1e-4 s has mesh forces about 12 times too large
@@ -540,12 +544,7 @@ pub fn idle_rattle_warnings(scene: &Scene, opt: &SimOptions) -> Vec<String> {
                   scene; docs/validation.md, \"Idle rattle\")";
     match opt.method.name() {
         "generalized-alpha" => {
-            let s = opt.settings();
-            let dt = if s.t_end.is_finite() && s.t_end > 0.0 {
-                crate::solve::integrator::FixedClock::new(s.t_end, s.dt).h
-            } else {
-                s.dt
-            };
+            let dt = clock_step(&opt.settings());
             if dt <= IDLE_RATTLE_STEP * (1.0 + 1e-9) {
                 return Vec::new();
             }
