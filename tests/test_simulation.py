@@ -285,6 +285,34 @@ def test_the_default_integrator_of_an_idle_scene_resolves_its_rattle() -> None:
     assert [r.options["integrator"] for r in runs] == ["dopri5", "generalized-alpha"]
 
 
+def test_a_light_load_gets_the_idle_default() -> None:
+    """A load whose nominal sun/planet mesh force is below 10 N (here 1e-4 of the rated torque,
+    0.95 N) is light: it runs dopri5 at atol 1e-11 m, rtol 1e-9 by default, whose force
+    statistics over [0.5, 1] s are within 1 % of a run at 1e-13 m, 1e-11 (measured 3e-5, input
+    torque 0.2 %); generalized-alpha at dt 1e-4 s, asked for by name, is reported and its peak mesh
+    force is 78 % too high there (a check at 30 %). At 1e-2 of the rated torque (95 N) the load is
+    not light and keeps the loaded default."""
+    rated = Scene.paper("rated")
+    torque = rated.to_dict()["load"]["torque"]
+    assert rated.nominal_mesh_force == pytest.approx(9512.94, abs=0.01)
+    assert not rated.light_load and Scene.paper("idle").light_load
+    assert Scene.paper("idle").nominal_mesh_force == 0.0
+    scene = rated.replace(**{"load.torque": 1e-4 * torque})
+    assert scene.light_load and scene.nominal_mesh_force == pytest.approx(0.9513, abs=1e-4)
+    kw: dict[str, Any] = {"channels": ["motion", "pins", "mesh"], "progress": False}
+    default = simulate(scene, 1.0, **kw)
+    assert (default.options["integrator"], default.options["atol"], default.options["rtol"]) == ("dopri5", 1e-11, 1e-9)
+    ref = _idle_statistics(simulate(scene, 1.0, "dopri5", atol=1e-13, rtol=1e-11, **kw))
+    np.testing.assert_allclose(_idle_statistics(default), ref, rtol=0.01)
+    with pytest.warns(RuntimeWarning, match=r"light load \(nominal mesh force 0.951 N, below 10 N\)"):
+        fixed = _idle_statistics(simulate(scene, 1.0, "generalized-alpha", **kw))
+    assert fixed[3] > 1.3 * ref[3]
+    heavier = rated.replace(**{"load.torque": 1e-2 * torque})
+    assert not heavier.light_load
+    runs = rvdyn.sweep([scene, heavier], 1e-3, channels=["motion"])
+    assert [r.options["integrator"] for r in runs] == ["dopri5", "generalized-alpha"]
+
+
 def test_sweep_runs_a_grid_and_reports_failures() -> None:
     base = Scene.paper("rated", initial="steady")
     out = rvdyn.sweep(base, 0.01, grid={"load.torque": [1e4, 2e4]}, channels=["pins"])

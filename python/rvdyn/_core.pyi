@@ -360,6 +360,11 @@ class CompiledScene:
         """The value at a dotted field path, as JSON text."""
     def replace(self, changes: list[tuple[str, str]]) -> CompiledScene:
         """A new validated scene with (dotted path, JSON value) changes."""
+    def nominal_mesh_force(self) -> float | None:
+        """Nominal tangential force of one sun/planet mesh at the load's largest torque [N]
+        (0 idle, None without a first stage)."""
+    def is_light_load(self) -> bool:
+        """Whether the load is light (idle, or a nominal mesh force below 10 N)."""
     def model_info(self) -> dict[str, Any]:
         """Mass properties [kg, kg m^2] and generalised masses the model uses (SI), crank radius
         [m], ratio, number of free coordinates (dof) and joint kind."""

@@ -221,6 +221,23 @@ class Scene:
         without a first stage (``-zc``: the output turns against the cranks)."""
         return float(self.model_info()["ratio"])
 
+    @property
+    def nominal_mesh_force(self) -> float | None:
+        """Nominal tangential force of one sun/planet mesh [N] at the load's largest torque
+        magnitude: ``2 T_sun / (d_sun planets)`` with ``T_sun`` that torque over the ratio
+        (ISO 6336-1 clause 6; 9.5 kN for ``Scene.paper("rated")``). 0 for an idle scene, None
+        without a first stage."""
+        return self._compiled.nominal_mesh_force()
+
+    @property
+    def light_load(self) -> bool:
+        """Whether the load is light: idle, or a :attr:`nominal_mesh_force` below 10 N (below
+        about 1e-3 of the paper's rated torque). Its contact forces are a few newtons, which the
+        loaded scenes' default integrators do not resolve: such a scene runs ``IDLE_DEFAULT``
+        (docs/validation.md, "Idle rattle and light loads"). A scene without a first stage is
+        light only when idle."""
+        return self._compiled.is_light_load()
+
     # ------------------------------------------------------------------ value semantics
     def __eq__(self, other: object) -> bool:
         return isinstance(other, Scene) and self._compiled == other._compiled

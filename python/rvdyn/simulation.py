@@ -56,19 +56,21 @@ def _resolve_options(options: Options | None, integrator: str | None, changes: d
 ROLLER_DEFAULT: dict[str, Any] = {"integrator": "dopri5", "atol": 1e-8, "rtol": 1e-4}
 
 
-#: The default integrator of an idle scene (no load torque), with or without roller bearings. Its forces
-#: are a decaying rattle of a few newtons and less (about 7e-8 m of mesh deflection over the
-#: second half of a 1 s run, against 9e-5 m at rated load), which generalized-alpha at dt 1e-4 s
-#: does not resolve: over [0.5, 1] s its mesh-force and input-torque RMS are 12 times the
-#: converged values, and the error-controlled generalized-alpha at atol 1e-9 m has pin forces
-#: 3.4 times theirs (RMS). dopri5 at atol 1e-11 m, rtol 1e-9 is within 0.5 % of a run at 1e-13 m,
-#: 1e-11 in every force statistic (docs/validation.md, "Idle rattle"). On the physical preset
-#: ``ROLLER_DEFAULT`` put the idle peak pin force 62 % too high over [0.25, 0.5] s; this, 1.2 %.
+#: The default integrator of a light scene (``Scene.light_load``: idle, or a nominal mesh force
+#: below 10 N), with or without roller bearings. Its forces are a few newtons (the idle paper
+#: scene's a decaying rattle with about 7e-8 m of mesh deflection over the second half of a 1 s
+#: run, against 9e-5 m at rated load), which the loaded scenes' defaults do not resolve:
+#: generalized-alpha at dt 1e-4 s has the idle mesh-force and input-torque RMS 12 times the
+#: converged values over [0.5, 1] s and the peak mesh force 78 % too high at a nominal mesh force
+#: of 0.95 N; ``ROLLER_DEFAULT`` put the physical preset's peak pin force 62 % too high idle over
+#: [0.25, 0.5] s and 120 % at 0.95 N. dopri5 at atol 1e-11 m, rtol 1e-9 is within 0.5 % of a run
+#: at 1e-13 m, 1e-11 in every force statistic of the idle paper scene and within 3 % in the pin
+#: statistics of the others (docs/validation.md, "Idle rattle and light loads").
 IDLE_DEFAULT: dict[str, Any] = {"integrator": "dopri5", "atol": 1e-11, "rtol": 1e-9}
 
 
-def _is_idle(scene: Scene) -> bool:
-    return bool(scene.to_dict()["load"].get("kind") == "idle")
+def _is_light(scene: Scene) -> bool:
+    return scene.light_load
 
 
 def _has_rollers(scene: Scene) -> bool:
@@ -80,11 +82,11 @@ def _has_rollers(scene: Scene) -> bool:
 def _scene_defaults(scenes: Sequence[Scene], options: Options | None, integrator: str | None,
                     changes: dict[str, Any]) -> tuple[str | None, dict[str, Any]]:
     """The integrator and tolerances a call uses when it names none (unless ``options``,
-    ``integrator`` or a step ``dt`` is given): ``ROLLER_DEFAULT`` for scenes with roller
-    bearings, ``IDLE_DEFAULT`` when every scene is idle, the library's defaults otherwise."""
+    ``integrator`` or a step ``dt`` is given): ``IDLE_DEFAULT`` when every scene is light,
+    ``ROLLER_DEFAULT`` for scenes with roller bearings, the library's defaults otherwise."""
     if options is not None or integrator is not None or changes.get("dt") is not None:
         return integrator, changes
-    if scenes and all(_is_idle(s) for s in scenes):
+    if scenes and all(_is_light(s) for s in scenes):
         default = IDLE_DEFAULT
     elif any(_has_rollers(s) for s in scenes):
         default = ROLLER_DEFAULT
@@ -156,10 +158,10 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     ``rtol`` relative velocity tolerance, default 1e-6) or ``"rk4"`` (fixed step ``dt``,
     default 1e-5 s). Without ``integrator``, ``options`` or ``dt``, a scene with roller bearings
     (``Scene.physical``) runs dopri5 at atol 1e-8 m, rtol 1e-4 (``ROLLER_DEFAULT``: 3.0e-4 of the
-    peak pin force over [0.05, 0.1] s from rest, where generalized-alpha at dt 1e-4 s is off by 3 %); an idle
-    scene (load kind ``"idle"``, with or without them) runs dopri5 at atol 1e-11 m, rtol 1e-9 (``IDLE_DEFAULT``: its
-    rattle of a few newtons needs that; generalized-alpha at dt 1e-4 s has mesh forces 12 times too
-    large in it); other scenes generalized-alpha. ``atol`` is at most 1e-6 m and ``rtol`` at most 1e-2 (looser ones are a
+    peak pin force over [0.05, 0.1] s from rest, where generalized-alpha at dt 1e-4 s is off by 3 %); a light
+    scene (``Scene.light_load``: idle, or a nominal mesh force below 10 N; with or without them) runs dopri5 at
+    atol 1e-11 m, rtol 1e-9 (``IDLE_DEFAULT``: its forces of a few newtons need that; generalized-alpha at dt
+    1e-4 s has idle mesh forces 12 times too large); other scenes generalized-alpha. ``atol`` is at most 1e-6 m and ``rtol`` at most 1e-2 (looser ones are a
     ``ParameterError``: the contact approaches are tens of micrometres).
     record_interval: sample spacing [s], at most ``t_end`` (default 1e-4 s, or ``t_end`` for
     a shorter run), coarsened so that at most ``max_samples`` (default 50 000) samples are
@@ -172,7 +174,7 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     bound on the gap from the last exact query and the disc's motion since); the answer is the
     same either way, ``False`` exists to measure the saving.
     step_check: what a step that cannot be accurate for the scene does (fewer than 8 steps
-    per pin-mesh period; generalized-alpha above 2e-5 s, or its adaptive form, on an idle scene
+    per pin-mesh period; generalized-alpha above 2e-5 s, or its adaptive form, on a light scene
     from rest): ``"warn"`` (default, a ``RuntimeWarning``), ``"raise"``
     (:class:`rvdyn.ParameterError`) or ``"off"``.
     h_min, max_steps: smallest step [s] of an adaptive integrator (default 1e-13 s) and most
@@ -261,12 +263,12 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
              "max_samples": max_samples, "channels": channels, "skip_separated": skip_separated,
              "step_check": step_check, "h_min": h_min, "max_steps": max_steps}
     t = _t_end(t_end)
-    # Each scene gets the defaults simulate would give it: idle scenes, scenes with roller
+    # Each scene gets the defaults simulate would give it: light scenes, scenes with roller
     # bearings and the others run as groups, each with its own defaults.
     groups: dict[tuple[bool, bool], list[int]] = {}
     for i, s in enumerate(scene_list):
-        idle = _is_idle(s)
-        groups.setdefault((idle, not idle and _has_rollers(s)), []).append(i)
+        light = _is_light(s)
+        groups.setdefault((light, not light and _has_rollers(s)), []).append(i)
     plans = []
     for idx in groups.values():
         integ, changes = _scene_defaults([scene_list[i] for i in idx], options, integrator, given)

@@ -170,6 +170,17 @@ impl CompiledScene {
         Ok(Self::new(self.scene.replace(&parsed)?)?)
     }
 
+    /// Nominal tangential force of one sun/planet mesh at the load's largest torque \[N\] (0
+    /// idle, `None` without a first stage).
+    fn nominal_mesh_force(&self) -> Option<f64> {
+        self.scene.nominal_mesh_force()
+    }
+
+    /// Whether the load is light (idle, or a nominal mesh force below 10 N).
+    fn is_light_load(&self) -> bool {
+        self.scene.is_light_load()
+    }
+
     /// Mass properties and generalised masses the model uses (SI).
     fn model_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         model_info(py, &self.scene)
