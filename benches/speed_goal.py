@@ -1,5 +1,6 @@
 """The speed goal (BENCHMARKS.md, "Speed goal"): 5 s simulated of the rated default scene with a
-pin-force error of at most 0.1 % of the peak, in at most 0.5 s of wall time on one core.
+pin-force error of at most 0.1 % of the peak, in at most 0.05 s of core time (issue 13; 0.5 s
+was the first goal), and of the physical preset in at most 0.5 s on one core (issue 8).
 
 Run: ``python benches/speed_goal.py`` (about 40 s: the converged references take most of it).
 The error is measured over the whole 5 s run, after the start impact ([0.5, 5] s), against a
@@ -89,6 +90,7 @@ def main() -> int:
     print(f"{args.preset}, {t_end:g} s: reference {ref_wall:.2f} s wall, {ref_cpu:.2f} s CPU, peak "
           f"pin force {peak:.0f} N; tighter run differs by {err_of(f_tight)[0]:.1e} of the peak", flush=True)
     settings = [x for x in settings if args.only in f"{x[0]} {x[2]}"]
+    goal = 0.05 if args.preset == "paper" else 0.5  # issue 13 (paper), issue 8 (physical)
     for integrator, opts, what in settings:
         try:
             runs = [timed(scene, t_end, integrator, step_check="off", **opts, **KW) for _ in range(args.repeat)]
@@ -105,8 +107,8 @@ def main() -> int:
                      "evaluations": r0.stats.get("evaluations")})
         print(f"{integrator} {what}: wall {wall:.3f} s, CPU {cpu:.3f} s, {r0.stats['steps']} steps, "
               f"{r0.stats.get('evaluations')} evaluations, pin-force error max {e_max:.2e}, RMS {e_rms:.2e} "
-              f"of the peak; goal (<= 0.5 s, <= 1e-3): "
-              f"{'met' if wall <= 0.5 and e_max <= 1e-3 else 'not met'}", flush=True)
+              f"of the peak; goal (<= {goal:g} s CPU, <= 1e-3): "
+              f"{'met' if cpu <= goal and e_max <= 1e-3 else 'not met'}", flush=True)
     OUT.mkdir(exist_ok=True)
     name = "speed_goal.json" if args.preset == "paper" and t_end == T else \
         f"speed_goal_{args.preset}_{t_end:g}s{'_' + args.only.replace(' ', '_') if args.only else ''}.json"
