@@ -149,7 +149,9 @@ def test_the_idle_default_holds_for_the_physical_preset() -> None:
         return np.array([np.sqrt(np.mean(pins ** 2)), pins.max()])
 
     np.testing.assert_allclose(stats(default), stats(ref), rtol=0.03)
-    roller = stats(simulate(scene, 0.5, "dopri5", atol=1e-8, rtol=1e-4, **kw))
+    # Asked for by name, the roller default's tolerance is reported on this scene.
+    with pytest.warns(RuntimeWarning, match="dopri5 with atol = 1e-8 m on an idle scene"):
+        roller = stats(simulate(scene, 0.5, "dopri5", atol=1e-8, rtol=1e-4, **kw))
     assert roller[1] > 1.3 * stats(ref)[1]
 
 

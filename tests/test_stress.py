@@ -80,7 +80,9 @@ CASES = [
     # Idle flows are tiny, so generalized-alpha's numerical damping of the start impact is
     # ~7 % of them; dopri5 closes the same balance to 1e-6 (next case).
     Case("idle, step start", {}, 0.5, load="idle", energy_tol=0.1, warns=True),
-    Case("idle, step start, dopri5", {}, 0.5, "dopri5", load="idle", energy_tol=1e-4),
+    # dopri5 at its library default atol (1e-9 m) is reported on an idle scene (the idle default
+    # is 1e-11 m); the energy balance closes all the same.
+    Case("idle, step start, dopri5", {}, 0.5, "dopri5", load="idle", energy_tol=1e-4, warns=True),
     Case("load step 0 -> rated at 0.1 s", {"load": {"kind": "step", "before": 0.0, "after": RATED, "time": 0.1}},
          0.5, t_start=0.2),
     # The reversal impact is under-resolved by the fixed step: the check says so.
@@ -146,8 +148,8 @@ def check(case: Case, row: dict[str, Any]) -> None:
         return
     assert row["outcome"] == "ok", row.get("message")
     assert row["finite"]
-    # The fixed-step check warns exactly where the step cannot resolve the pin mesh, a load
-    # reversal or an idle rattle.
+    # The step check warns exactly where the step cannot resolve the pin mesh, a load
+    # reversal or an idle rattle (or dopri5's atol cannot resolve the latter).
     assert bool(row["warnings"]) == case.warns, row["warnings"]
     assert all("pin-mesh period" in w or "load reversal" in w or "idle scene" in w for w in row["warnings"])
     # Penetration bounded: far below the 1 mm bound (the largest elastic approach of the paper's

@@ -390,7 +390,7 @@ class Options:
     (default 0.8); record_interval [s], <= t_end (None = 1e-4 s or t_end if shorter);
     max_samples (default 50 000); channels (groups: "motion", "pins", "contact_points", "mesh",
     "energy", "bearings"; None = all but contact points); skip_separated (default True);
-    step_check ("warn", "raise" or "off": a fixed step that cannot be accurate, default "warn");
+    step_check ("warn", "raise" or "off": a step or tolerance that cannot be accurate, default "warn");
     h_min [s] and max_steps (bounds of an adaptive method, default 1e-13 s and 1e8).
     """
 

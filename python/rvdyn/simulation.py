@@ -174,8 +174,8 @@ def simulate(scene: Scene, t_end: float, integrator: str | None = None, *, optio
     bound on the gap from the last exact query and the disc's motion since); the answer is the
     same either way, ``False`` exists to measure the saving.
     step_check: what a step that cannot be accurate for the scene does (fewer than 8 steps
-    per pin-mesh period; generalized-alpha above 2e-5 s, or its adaptive form, on a light scene
-    from rest): ``"warn"`` (default, a ``RuntimeWarning``), ``"raise"``
+    per pin-mesh period; generalized-alpha above 2e-5 s, its adaptive form, or dopri5 above atol
+    1e-10 m, on a light scene from rest): ``"warn"`` (default, a ``RuntimeWarning``), ``"raise"``
     (:class:`rvdyn.ParameterError`) or ``"off"``.
     h_min, max_steps: smallest step [s] of an adaptive integrator (default 1e-13 s) and most
     steps of any (default 1e8); beyond either an adaptive run stops with
