@@ -69,10 +69,6 @@ ROLLER_DEFAULT: dict[str, Any] = {"integrator": "dopri5", "atol": 1e-8, "rtol": 
 IDLE_DEFAULT: dict[str, Any] = {"integrator": "dopri5", "atol": 1e-11, "rtol": 1e-9}
 
 
-def _is_light(scene: Scene) -> bool:
-    return scene.light_load
-
-
 def _has_rollers(scene: Scene) -> bool:
     joints = scene.to_dict()["joints"]
     return joints.get("kind") == "compliant" and any(
@@ -86,7 +82,7 @@ def _scene_defaults(scenes: Sequence[Scene], options: Options | None, integrator
     ``ROLLER_DEFAULT`` for scenes with roller bearings, the library's defaults otherwise."""
     if options is not None or integrator is not None or changes.get("dt") is not None:
         return integrator, changes
-    if scenes and all(_is_light(s) for s in scenes):
+    if scenes and all(s.light_load for s in scenes):
         default = IDLE_DEFAULT
     elif any(_has_rollers(s) for s in scenes):
         default = ROLLER_DEFAULT
@@ -267,7 +263,7 @@ def sweep(scenes: Scene | Sequence[Scene], t_end: float, integrator: str | None 
     # bearings and the others run as groups, each with its own defaults.
     groups: dict[tuple[bool, bool], list[int]] = {}
     for i, s in enumerate(scene_list):
-        light = _is_light(s)
+        light = s.light_load
         groups.setdefault((light, not light and _has_rollers(s)), []).append(i)
     plans = []
     for idx in groups.values():
