@@ -10,7 +10,7 @@ import importlib
 
 import pytest
 
-MODULES = ["rvdyn", "rvdyn.scene", "rvdyn.simulation", "rvdyn.result"]
+MODULES = ["rvdyn", "rvdyn.scene", "rvdyn.simulation", "rvdyn.result", "rvdyn.bearing"]
 
 
 @pytest.mark.parametrize("name", MODULES)

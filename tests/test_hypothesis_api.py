@@ -324,6 +324,36 @@ def test_impact_force(arrays, k, exponent, cmax, depth):
     check("impact_force", lambda: rvdyn.impact_force(x, v, k, exponent, cmax, depth))
 
 
+# --- bearings -------------------------------------------------------------------------------
+
+force_arrays = st.one_of(
+    hnp.arrays(np.float64, hnp.array_shapes(min_dims=1, max_dims=4, max_side=3),
+               elements=st.floats(allow_nan=True, allow_infinity=True)),
+    hnp.arrays(np.float64, st.sampled_from([(2,), (5, 2), (4, 3, 2)]), elements=st.floats(-1e6, 1e6)),
+)
+disc_force_arrays = st.one_of(
+    hnp.arrays(np.float64, hnp.array_shapes(min_dims=1, max_dims=5, max_side=3),
+               elements=st.floats(allow_nan=True, allow_infinity=True)),
+    hnp.arrays(np.float64, st.sampled_from([(2, 2), (5, 2, 2), (4, 3, 2, 2)]), elements=st.floats(-1e6, 1e6)),
+)
+
+
+@SETTINGS
+@given(force_arrays, disc_force_arrays, any_real, any_real, st.lists(any_real, max_size=3), any_real,
+       st.lists(any_real, max_size=3))
+def test_crank_bearing_rows_and_system_life(crank, discs_f, za, zb, zd, zp, lives):
+    check("crank_bearing_rows", lambda: rvdyn.crank_bearing_rows(
+        crank, discs_f, bearings=(za, zb), discs=zd, planet=zp))
+    check("crank_bearing_rows", lambda: rvdyn.crank_bearing_rows(
+        crank, discs_f, bearings=(-0.06, 0.06), discs=(-0.02, 0.02), planet=-0.09))
+    check("crank_bearing_rows", lambda: rvdyn.CrankLayout(
+        bearings=(za, zb), discs=tuple(zd), planet=zp).rows(crank, discs_f))
+    if lives and all(isinstance(x, float) and x == math.inf for x in lives):
+        assert rvdyn._core.roller_system_life(lives) == math.inf  # bearings that never fail
+    else:
+        check("roller_system_life", lambda: rvdyn._core.roller_system_life(lives))
+
+
 # --- kinematics -----------------------------------------------------------------------------
 
 

@@ -11,6 +11,8 @@ InvoluteStage
     The involute first stage (sun and planets).
 contact_stiffness, stiffness_maximum, hertz_line_contact, impact_force
     Contact laws (vectorised, numpy in and out).
+crank_bearing_rows, CrankLayout
+    A crank's two bearing loads from the planar models' lumped crank bearing force.
 transmission_ratio, body_speeds, operating_point
     Kinematics and the operating point.
 Scene, Options, simulate, sweep, Result
@@ -46,6 +48,7 @@ from ._core import (
     InvoluteStage,
     body_speeds,
     contact_stiffness,
+    crank_bearing_rows,
     hertz_line_contact,
     impact_force,
     operating_point,
@@ -54,6 +57,7 @@ from ._core import (
 )
 from ._types import GapResult, LineContact, OperatingPoint
 from .analysis.campbell import campbell
+from .bearing import CrankLayout
 from .analysis.modes import modes, modes_at, modes_over_mesh
 from .analysis.spectrum import excitation_orders, order_spectrum
 from .result import Result
@@ -96,6 +100,8 @@ __all__ = [
     "contact_stiffness",
     "stiffness_maximum",
     "hertz_line_contact",
+    "crank_bearing_rows",
+    "CrankLayout",
     "impact_force",
     "transmission_ratio",
     "body_speeds",

@@ -23,6 +23,8 @@ __all__ = [
     "hertz_line_contact",
     "impact_force",
     "roller_bearing_life",
+    "crank_bearing_rows",
+    "roller_system_life",
     "PAPER_IMPACT_STIFFNESS",
     "PAPER_IMPACT_EXPONENT",
     "PAPER_IMPACT_MAX_DAMPING",
@@ -304,6 +306,23 @@ def hertz_line_contact(
 def roller_bearing_life(rating: float, loads: Sequence[float], revolutions: Sequence[float]) -> tuple[float, float]:
     """Equivalent load P [N] and ISO 281 L10 [million revolutions] of a roller bearing of rating C
     [N] over loads [N] weighted by revolutions; (0, inf) for a bearing that did not turn."""
+
+def roller_system_life(lives: Sequence[float]) -> float:
+    """L10 of roller bearings that fail when any one does: ``(sum L_i^-9/8)^(-8/9)``, in the
+    unit of ``lives``."""
+
+def crank_bearing_rows(
+    crank_bearing_force: ArrayLike,
+    eccentric_bearing_force: ArrayLike,
+    *,
+    bearings: tuple[float, float],
+    discs: Sequence[float],
+    planet: float,
+) -> NDArray[np.float64]:
+    """Forces [N] of a crank's two bearings (at axial positions ``bearings`` [m]) on the crank,
+    shape (..., 2, 2), from the lumped crank bearing force (..., 2) and the discs' eccentric
+    bearing forces (..., discs, 2), with the discs at ``discs`` and the planet at ``planet``
+    [m] along the crank: statics of a rigid crank on two supports."""
 
 def impact_force(
     penetration: ArrayLike,

@@ -12,7 +12,7 @@ import math
 import warnings
 import zipfile
 from pathlib import Path
-from typing import Any, Generic, Iterable, TypeVar, overload
+from typing import TYPE_CHECKING, Any, Generic, Iterable, TypeVar, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,6 +23,9 @@ from ._args import read_only
 from ._args import real as _real
 from ._args import whole as _whole
 from .plotting import pin_indices
+
+if TYPE_CHECKING:
+    from .bearing import CrankLayout
 
 __all__ = ["Result", "CHANNELS", "CHANNEL_SPECS"]
 
@@ -317,7 +320,8 @@ class Result:
         return {name: float(np.mean(getattr(self, f"{name}_friction_power")[i0:]))
                 for name in ("pin", "mesh", "bearing")}
 
-    def bearing_life(self, t_start: float | None = None) -> dict[str, dict[str, float]]:
+    def bearing_life(self, t_start: float | None = None,
+                     crank_layout: CrankLayout | None = None) -> dict[str, dict[str, float]]:
         """Peak and equivalent radial load [N], ISO 281 rating [N] and basic rating life
         ``L10`` [million revolutions and hours], ISO 76 static rating ``C0r`` [N] and static safety
         ``s0 = C0r / peak load`` (a ``RuntimeWarning`` below 1: the raceways yield, and the elastic
@@ -330,7 +334,17 @@ class Result:
         of about three over the revolution, so part of it over- or understates the life), and
         one of fewer than two samples a ``ParameterError``. Needs the ``"bearings"`` and ``"motion"`` channels and a
         scene whose bearings are built from rollers (``rollers``): ``ParameterError`` if none is;
-        a bearing family without rollers is left out."""
+        a bearing family without rollers is left out.
+
+        ``crank_layout`` (:class:`rvdyn.bearing.CrankLayout`, axial positions [m]) splits each
+        crank's lumped bearing into its two bearings by the statics of the rigid crank
+        (:func:`rvdyn.crank_bearing_rows`): the entry ``"crank"`` is then replaced by
+        ``"crank_a"`` and ``"crank_b"`` (the bearings at ``crank_layout.bearings[0]`` and
+        ``[1]``), each rated with rollers of ``crank_layout.roller_length`` (default half the
+        lumped length), and ``"crank_pair"`` gives the L10 of the worst crank's two bearings
+        as a system (Lundberg-Palmgren, ``(L_a^-9/8 + L_b^-9/8)^(-8/9)``) and the smaller
+        ``static_safety`` of the two. The lumped entry hides the discs' tilting moment and
+        rates the two bearings as one row, so it overstates their life and static safety."""
         compiled = _core.CompiledScene.from_json(json.dumps(self.scene))
         c_ecc, c_crank = compiled.bearing_ratings()
         s_ecc, s_crank = compiled.bearing_ratings("static")
@@ -363,11 +377,19 @@ class Result:
         duration = float(t[-1] - t[0])
         out: dict[str, dict[str, float]] = {}
         crank = self.crank_angle[i0:]
-        for name, rating, static, forces, rel in (
+        crank_rel = crank - self.carrier_angle[i0:][:, None]
+        families: list[tuple[str, float | None, float | None, NDArray[np.float64], NDArray[np.float64]]] = [
             ("eccentric", c_ecc, s_ecc, self.eccentric_bearing_force[i0:],
-             crank[:, :, None] - self.disc_angle[i0:][:, None, :]),
-            ("crank", c_crank, s_crank, self.crank_bearing_force[i0:], crank - self.carrier_angle[i0:][:, None]),
-        ):
+             crank[:, :, None] - self.disc_angle[i0:][:, None, :])]
+        if crank_layout is None:
+            families.append(("crank", c_crank, s_crank, self.crank_bearing_force[i0:], crank_rel))
+        else:
+            row = _core.CompiledScene.from_json(json.dumps(crank_layout.row_scene(self.scene)))
+            c_row, s_row = row.bearing_ratings()[1], row.bearing_ratings("static")[1]
+            rows = crank_layout.rows(self.crank_bearing_force[i0:], self.eccentric_bearing_force[i0:])
+            families += [(f"crank_{side}", c_row, s_row, rows[:, :, j], crank_rel) for j, side in enumerate("ab")]
+        crank_lives: dict[str, dict[tuple[int, ...], tuple[float, float]]] = {}
+        for name, rating, static, forces, rel in families:
             if rating is None or static is None:
                 continue
             mag = np.linalg.norm(forces, axis=-1)
@@ -378,6 +400,7 @@ class Result:
             lives = {j: _core.roller_bearing_life(rating, load[(slice(None),) + j].tolist(),
                                                   rev[(slice(None),) + j].tolist())
                      for j in np.ndindex(*load.shape[1:])}
+            crank_lives[name] = lives
             worst = max(lives, key=lambda j: lives[j][0])
             p, l10 = lives[worst]
             rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
@@ -393,6 +416,17 @@ class Result:
                          "static_rating": float(static), "static_safety": s0,
                          "l10_million_revolutions": l10,
                          "l10_hours": l10 * 1e6 / (60.0 * rpm) if rpm > 0 else math.inf}
+        if "crank_a" in crank_lives:
+            # A crank's two bearings fail as a system (Lundberg-Palmgren); the worst crank counts.
+            pair = {j: _core.roller_system_life([crank_lives["crank_a"][j][1], crank_lives["crank_b"][j][1]])
+                    for j in crank_lives["crank_a"]}
+            worst = min(pair, key=lambda j: pair[j])
+            turns_worst = float(np.abs(np.diff(crank_rel[(slice(None),) + worst], axis=0)).sum()) / (2 * np.pi)
+            rpm = turns_worst / duration * 60.0 if duration > 0 else 0.0
+            out["crank_pair"] = {
+                "static_safety": min(out["crank_a"]["static_safety"], out["crank_b"]["static_safety"]),
+                "l10_million_revolutions": pair[worst],
+                "l10_hours": pair[worst] * 1e6 / (60.0 * rpm) if rpm > 0 else math.inf}
         return out
 
     # -------------------------------------------------------------------- files

@@ -41,7 +41,7 @@
 //!
 //! Theory: docs/model.md, section "Load rating, life and friction torque".
 
-use crate::error::{Result, RvdynError, require_non_negative, require_positive};
+use crate::error::{Result, RvdynError, num, require_non_negative, require_positive};
 
 /// Rating factor `b_m` of ISO 281 for cylindrical and needle roller bearings (machined rings).
 pub const BM_ROLLER: f64 = 1.1;
@@ -174,6 +174,48 @@ pub fn l10_roller(rating: f64, equivalent_load: f64) -> Result<f64> {
         return Ok(f64::INFINITY);
     }
     Ok((rating / equivalent_load).powf(10.0 / 3.0))
+}
+
+/// Weibull slope of roller bearings' fatigue lives (Lundberg-Palmgren; Harris & Kotzalas,
+/// Essential Concepts of Bearing Technology, 5th ed., 2007, ch. 11).
+pub const ROLLER_WEIBULL_SLOPE: f64 = 9.0 / 8.0;
+
+/// L10 of a system of roller bearings that fails when any one does (Lundberg-Palmgren:
+/// `L = (sum L_i^-e)^(-1/e)`, `e` = [`ROLLER_WEIBULL_SLOPE`]), in the unit of `lives`.
+///
+/// Errors (`Parameter`) for no life, or a life that is not positive (`inf`, a bearing that
+/// never fails, is allowed).
+///
+/// # Example
+///
+/// ```
+/// use rvdyn::bearing::system_life_roller;
+/// // Two equal bearings: 2^(-8/9) of one's life.
+/// let l = system_life_roller(&[1.0, 1.0]).unwrap();
+/// assert!((l - 2f64.powf(-8.0 / 9.0)).abs() < 1e-15);
+/// assert_eq!(system_life_roller(&[3.0, f64::INFINITY]).unwrap(), 3.0);
+/// ```
+pub fn system_life_roller(lives: &[f64]) -> Result<f64> {
+    if lives.is_empty() {
+        return Err(RvdynError::Parameter(
+            "a system life needs the life of at least one bearing".into(),
+        ));
+    }
+    let e = ROLLER_WEIBULL_SLOPE;
+    if let Some(&bad) = lives.iter().find(|l| l.is_nan() || **l <= 0.0) {
+        return Err(RvdynError::Parameter(format!(
+            "a bearing life must be positive (inf for a bearing that never fails), got {}",
+            num(bad)
+        )));
+    }
+    // Scaled by the shortest life: no overflow of L^-e for tiny lives, and one finite life
+    // comes back exactly.
+    let shortest = lives.iter().copied().fold(f64::INFINITY, f64::min);
+    if shortest == f64::INFINITY {
+        return Ok(f64::INFINITY);
+    }
+    let sum: f64 = lives.iter().map(|l| (l / shortest).powf(-e)).sum();
+    Ok(shortest * sum.powf(-1.0 / e))
 }
 
 /// Equivalent load \[N\] of a load history for roller-bearing life: `(sum w_k P_k^(10/3) /

@@ -1,0 +1,96 @@
+"""Rolling bearings after a run: the split of each crank's lumped bearing into its two rows.
+
+The planar models carry each crank on one lumped bearing. The two bearings of a real crank
+share its load unequally, because the two discs' eccentric loads point in different directions
+and act at different axial positions: a tilting moment the plane cannot see. Given the axial
+layout, the statics of a rigid crank on two radial supports (statically determinate) give each
+bearing's load (docs/model.md, "Crank bearing rows"); :meth:`rvdyn.Result.bearing_life` rates
+each one with ``crank_layout``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import _core
+from .errors import ParameterError
+
+__all__ = ["CrankLayout"]
+
+
+@dataclass(frozen=True)
+class CrankLayout:
+    """Where a crank's parts sit along its axis [m] (any origin, one direction for all).
+
+    Attributes
+    ----------
+    bearings : tuple[float, float]
+        Mid-planes of the two crank bearings, different ("a" and "b" in the results).
+    discs : tuple[float, ...]
+        Mid-planes of the discs (their eccentrics), one per disc in the order of the discs.
+    planet : float
+        Mid-plane of the planet, where the mesh force acts (a dynamic run's crank inertia force
+        is put there too: exact in the quasi-static LTCA; docs/model.md gives the error).
+    roller_length : float or None
+        Roller length of each of the two bearings [m], for their ISO 76/281 ratings; None: half
+        the scene's lumped crank roller length (the lumped row stands for two equal bearings).
+
+    Examples
+    --------
+    >>> layout = CrankLayout(bearings=(-0.06, 0.06), discs=(-0.02, 0.02), planet=-0.09)
+    >>> layout.rows([0.0, 0.0], [[1000.0, 0.0], [-1000.0, 0.0]]).tolist()  # a pure couple
+    [[333.33333333333337, 0.0], [-333.33333333333337, 0.0]]
+    """
+
+    bearings: tuple[float, float]
+    discs: tuple[float, ...]
+    planet: float
+    roller_length: float | None = None
+
+    def __post_init__(self) -> None:
+        try:
+            bearings = tuple(float(z) for z in self.bearings)
+            discs = tuple(float(z) for z in self.discs)
+            planet = float(self.planet)
+        except (TypeError, ValueError, OverflowError) as exc:
+            raise ParameterError(f"CrankLayout takes axial positions in metres (numbers): {exc}") from None
+        if len(bearings) != 2:
+            raise ParameterError(f"CrankLayout.bearings must hold the two crank bearings' positions [m], "
+                                 f"got {len(bearings)}")
+        length = self.roller_length
+        if length is not None and not (isinstance(length, (int, float)) and math.isfinite(length) and length > 0):
+            raise ParameterError(f"CrankLayout.roller_length must be a positive length [m] or None, got {length!r}")
+        object.__setattr__(self, "bearings", bearings)
+        object.__setattr__(self, "discs", discs)
+        object.__setattr__(self, "planet", planet)
+        # The core checks the rest (finite, a disc at least, bearings apart) with its message.
+        _core.crank_bearing_rows([0.0, 0.0], [[0.0, 0.0]] * len(discs), bearings=(bearings[0], bearings[1]),
+                                 discs=discs, planet=planet)
+
+    def rows(self, crank_bearing_force: ArrayLike, eccentric_bearing_force: ArrayLike) -> NDArray[np.float64]:
+        """Forces [N] of bearing ``bearings[0]`` and ``bearings[1]`` on the crank, shape
+        (..., 2, 2), from the lumped crank bearing force (..., 2) and the discs' eccentric
+        bearing forces (..., discs, 2) of a run or an LTCA (:func:`rvdyn.crank_bearing_rows`)."""
+        b = self.bearings
+        return _core.crank_bearing_rows(crank_bearing_force, eccentric_bearing_force, bearings=(b[0], b[1]),
+                                        discs=self.discs, planet=self.planet)
+
+    def row_scene(self, scene: dict[str, Any]) -> dict[str, Any]:
+        """A copy of ``scene`` (a dict) whose crank bearing is one of the two rows: rollers of
+        :attr:`roller_length`. ``ParameterError`` if the scene's crank bearing has no rollers."""
+        crank = ((scene.get("joints") or {}).get("crank_bearing") or {})
+        rollers = crank.get("rollers") if isinstance(crank, dict) else None
+        if not rollers:
+            raise ParameterError("crank_layout needs a crank bearing built from rollers "
+                                 "(joints.crank_bearing.rollers, as Scene.physical has)")
+        length = self.roller_length if self.roller_length is not None else 0.5 * float(rollers["length"])
+        out = dict(scene)
+        out["joints"] = {**scene["joints"], "crank_bearing": {**crank, "rollers": {**rollers, "length": length}}}
+        return out
+
+

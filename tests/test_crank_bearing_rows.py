@@ -1,0 +1,129 @@
+"""A crank's two bearings from the lumped crank bearing of the planar models
+(docs/model.md, "Crank bearing rows"): statics of a rigid crank on two supports, ISO 76/281
+ratings of one row, Lundberg-Palmgren system life."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import rvdyn
+from rvdyn import CrankLayout, ParameterError, Scene
+
+# The rated step at t = 0 and the short window are not what these tests look at.
+QUIET = [
+    "ignore:the (eccentric|crank) bearings' load reaches:RuntimeWarning",
+    "ignore:bearing_life. the window:RuntimeWarning",
+]
+
+
+@pytest.fixture(scope="module")
+def run() -> rvdyn.Result:
+    scene = Scene.physical("rated").replace(**{"initial": "steady", "drive.start": "step"})
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", category=RuntimeWarning)
+        return rvdyn.simulate(scene, 0.05, channels=["motion", "bearings"], progress=False)
+
+
+def test_lever_rule_and_pure_couple_by_hand() -> None:
+    # Everything in one plane a quarter of the span from bearing a: 3/4 and 1/4 of the load.
+    rows = rvdyn.crank_bearing_rows([4000.0, -800.0], [[1000.0, 0.0], [2000.0, 0.0]],
+                                    bearings=(0.0, 0.1), discs=(0.025, 0.025), planet=0.025)
+    np.testing.assert_allclose(rows, [[3000.0, -600.0], [1000.0, -200.0]], rtol=1e-14)
+    # Opposite disc loads R at +-d, bearings at +-s, no lumped force: a couple 2 R d carried as
+    # -+ 2 R d / (2 s) by the bearings, whatever the planet's position.
+    for planet in (-0.3, 0.0, 0.2):
+        rows = CrankLayout(bearings=(-0.05, 0.05), discs=(-0.02, 0.02), planet=planet).rows(
+            [0.0, 0.0], [[0.0, 1000.0], [0.0, -1000.0]])
+        np.testing.assert_allclose(rows, [[0.0, 400.0], [0.0, -400.0]], rtol=1e-12, atol=1e-9)
+
+
+def test_shapes_follow_the_recorded_channels(run: rvdyn.Result) -> None:
+    layout = CrankLayout(bearings=(-0.06, 0.06), discs=(-0.02, 0.02), planet=-0.09)
+    rows = layout.rows(run.crank_bearing_force, run.eccentric_bearing_force)
+    n = len(run.t)
+    assert rows.shape == (n, 3, 2, 2)
+    # The two rows carry the lumped force between them.
+    scale = np.abs(run.crank_bearing_force).max()
+    assert np.abs(rows.sum(axis=-2) - run.crank_bearing_force).max() < 1e-12 * scale
+    # The discs' loads point apart and sit apart: the tilting moment loads one bearing more
+    # than half the lumped load.
+    w = run.t >= 0.01
+    share = np.linalg.norm(rows[w], axis=-1).max(axis=-1) / np.linalg.norm(run.crank_bearing_force[w], axis=-1)
+    assert share.max() > 0.6
+
+
+@pytest.mark.filterwarnings(*QUIET)
+def test_a_mid_plane_layout_gives_the_closed_form_ratio_of_lives(run: rvdyn.Result) -> None:
+    # Discs and planet at the bearings' middle: each bearing carries exactly half the lumped
+    # load. With half-length rollers its rating is 2^(-7/9) of the lumped one (ISO 281,
+    # C ~ L_we^(7/9)), so its L10 is 2^(20/27) times the lumped row's, and the pair's
+    # (Lundberg-Palmgren, e = 9/8) 2^(-8/9) times that: 2^(-4/27) of the lumped row's. C0r
+    # (ISO 76, ~ L_we) halves with the load, so s0 is the lumped one.
+    lumped = run.bearing_life(t_start=0.01)["crank"]
+    split = run.bearing_life(t_start=0.01, crank_layout=CrankLayout(
+        bearings=(0.0, 0.12), discs=(0.06, 0.06), planet=0.06))
+    for side in ("crank_a", "crank_b"):
+        row = split[side]
+        assert row["rating"] == pytest.approx(lumped["rating"] * 2 ** (-7 / 9), rel=1e-12)
+        assert row["static_rating"] == pytest.approx(lumped["static_rating"] / 2, rel=1e-12)
+        assert row["peak_load"] == pytest.approx(lumped["peak_load"] / 2, rel=1e-9)
+        assert row["static_safety"] == pytest.approx(lumped["static_safety"], rel=1e-9)
+        assert row["l10_million_revolutions"] == pytest.approx(
+            lumped["l10_million_revolutions"] * 2 ** (20 / 27), rel=1e-9)
+    pair = split["crank_pair"]
+    assert pair["l10_million_revolutions"] == pytest.approx(
+        lumped["l10_million_revolutions"] * 2 ** (-4 / 27), rel=1e-9)
+    assert pair["l10_hours"] == pytest.approx(lumped["l10_hours"] * 2 ** (-4 / 27), rel=1e-9)
+    assert "crank" not in split and split["eccentric"] == run.bearing_life(t_start=0.01)["eccentric"]
+
+
+@pytest.mark.filterwarnings(*QUIET)
+def test_an_offset_layout_is_worse_than_the_lumped_row_and_says_so(run: rvdyn.Result) -> None:
+    layout = CrankLayout(bearings=(-0.06, 0.06), discs=(-0.02, 0.02), planet=-0.09)
+    with pytest.warns(RuntimeWarning, match="crank_a bearings' peak load"):
+        split = run.bearing_life(t_start=0.01, crank_layout=layout)
+    lumped = run.bearing_life(t_start=0.01)["crank"]
+    assert split["crank_pair"]["static_safety"] < 1.0 < lumped["static_safety"]
+    assert split["crank_pair"]["l10_million_revolutions"] < 0.9 * lumped["l10_million_revolutions"]
+    assert split["crank_pair"]["static_safety"] == min(split["crank_a"]["static_safety"],
+                                                       split["crank_b"]["static_safety"])
+
+
+def test_system_life_is_lundberg_palmgren() -> None:
+    a, b = 0.5, 0.8
+    assert rvdyn._core.roller_system_life([a, b]) == pytest.approx(
+        (a ** -1.125 + b ** -1.125) ** (-1 / 1.125), rel=1e-14)
+    assert rvdyn._core.roller_system_life([2.0, math.inf]) == 2.0
+    for bad in ([], [0.0, 1.0], [-1.0], [math.nan]):
+        with pytest.raises(ParameterError):
+            rvdyn._core.roller_system_life(bad)
+
+
+def test_bad_layouts_and_inputs_are_refused() -> None:
+    for kwargs, match in (
+        ({"bearings": (0.05, 0.05), "discs": (0.0, 0.01), "planet": 0.0}, "different axial positions"),
+        ({"bearings": (0.0, 0.1), "discs": (0.0, math.nan), "planet": 0.0}, "finite"),
+        ({"bearings": (0.0, 0.1), "discs": (), "planet": 0.0}, "every disc"),
+        ({"bearings": (0.0, 0.1, 0.2), "discs": (0.0,), "planet": 0.0}, "two crank bearings"),
+        ({"bearings": (0.0, 0.1), "discs": ("a",), "planet": 0.0}, "metres"),
+        ({"bearings": (0.0, 0.1), "discs": (0.0,), "planet": 0.0, "roller_length": -0.02}, "roller_length"),
+    ):
+        with pytest.raises(ParameterError, match=match):
+            CrankLayout(**kwargs)  # type: ignore[arg-type]
+    layout = CrankLayout(bearings=(0.0, 0.1), discs=(0.03, 0.07), planet=-0.02)
+    with pytest.raises(ParameterError, match=r"shape \(4, 2, 2\)"):
+        layout.rows(np.zeros((4, 2)), np.zeros((4, 3, 2)))
+    with pytest.raises(ParameterError, match=r"\(\.\.\., 2\)"):
+        layout.rows(np.zeros((4, 3)), np.zeros((4, 2, 2)))
+    with pytest.raises(ParameterError, match="finite"):
+        layout.rows([math.inf, 0.0], [[0.0, 0.0], [0.0, 0.0]])
+
+
+def test_a_layout_needs_roller_crank_bearings() -> None:
+    r = rvdyn.simulate(Scene.paper("rated"), 0.002, channels=["motion", "bearings"], progress=False)
+    with pytest.raises(ParameterError, match="rollers"):
+        r.bearing_life(crank_layout=CrankLayout(bearings=(0.0, 0.1), discs=(0.03, 0.07), planet=-0.02))
