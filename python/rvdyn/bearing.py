@@ -92,5 +92,3 @@ class CrankLayout:
         out = dict(scene)
         out["joints"] = {**scene["joints"], "crank_bearing": {**crank, "rollers": {**rollers, "length": length}}}
         return out
-
-

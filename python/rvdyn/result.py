@@ -388,7 +388,8 @@ class Result:
             c_row, s_row = row.bearing_ratings()[1], row.bearing_ratings("static")[1]
             rows = crank_layout.rows(self.crank_bearing_force[i0:], self.eccentric_bearing_force[i0:])
             families += [(f"crank_{side}", c_row, s_row, rows[:, :, j], crank_rel) for j, side in enumerate("ab")]
-        crank_lives: dict[str, dict[tuple[int, ...], tuple[float, float]]] = {}
+        # Per crank row: the (equivalent load, L10) of each crank and its revolutions.
+        crank_lives: dict[str, tuple[dict[tuple[int, ...], tuple[float, float]], NDArray[np.float64]]] = {}
         for name, rating, static, forces, rel in families:
             if rating is None or static is None:
                 continue
@@ -400,7 +401,7 @@ class Result:
             lives = {j: _core.roller_bearing_life(rating, load[(slice(None),) + j].tolist(),
                                                   rev[(slice(None),) + j].tolist())
                      for j in np.ndindex(*load.shape[1:])}
-            crank_lives[name] = lives
+            crank_lives[name] = (lives, total)
             worst = max(lives, key=lambda j: lives[j][0])
             p, l10 = lives[worst]
             rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
@@ -418,11 +419,10 @@ class Result:
                          "l10_hours": l10 * 1e6 / (60.0 * rpm) if rpm > 0 else math.inf}
         if "crank_a" in crank_lives:
             # A crank's two bearings fail as a system (Lundberg-Palmgren); the worst crank counts.
-            pair = {j: _core.roller_system_life([crank_lives["crank_a"][j][1], crank_lives["crank_b"][j][1]])
-                    for j in crank_lives["crank_a"]}
+            (lives_a, total), (lives_b, _) = crank_lives["crank_a"], crank_lives["crank_b"]
+            pair = {j: _core.roller_system_life([lives_a[j][1], lives_b[j][1]]) for j in lives_a}
             worst = min(pair, key=lambda j: pair[j])
-            turns_worst = float(np.abs(np.diff(crank_rel[(slice(None),) + worst], axis=0)).sum()) / (2 * np.pi)
-            rpm = turns_worst / duration * 60.0 if duration > 0 else 0.0
+            rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
             out["crank_pair"] = {
                 "static_safety": min(out["crank_a"]["static_safety"], out["crank_b"]["static_safety"]),
                 "l10_million_revolutions": pair[worst],
