@@ -203,15 +203,16 @@ def _helper_against_alone(tmp: str) -> None:
     started = []
     start = paper._Helper.start.__func__
 
-    def spy(cls, out):
-        helper = start(cls, out)
-        started.append(helper is not None)
+    def spy(cls, draw, jobs):
+        helper = start(cls, draw, jobs)
+        started.append((helper is not None, list(jobs)))
         return helper
 
     paper._Helper.start = classmethod(spy)
     assert paper.main(_args(with_helper, load="idle")) == 0
-    assert started == [True], "the helper process should draw here (Linux, no other thread)"
-    paper._Helper.start = classmethod(lambda cls, out: None)
+    theirs = paper._split([("idle", name) for name in paper.FIGURES])[1]
+    assert started == [(True, theirs)], "the helper process should draw here (Linux, no other thread)"
+    paper._Helper.start = classmethod(lambda cls, draw, jobs: None)
     assert paper.main(_args(alone, load="idle")) == 0
     names = sorted(p.name for p in alone.glob("*.png"))
     assert len(names) == len(paper.FIGURES)
@@ -220,22 +221,58 @@ def _helper_against_alone(tmp: str) -> None:
         assert np.array_equal(np.asarray(Image.open(with_helper / n)), np.asarray(Image.open(alone / n))), n
 
 
-def test_helper_process_writes_the_same_figures_as_this_process(tmp_path) -> None:
-    # In a fresh interpreter: this test process may hold other threads (earlier tests' pools),
-    # and rvdyn paper then draws everything itself instead of forking.
+def _helper_error(tmp: str) -> None:
+    """An OSError in the helper process reaches the caller, and the helper is gone (run in a
+    process of its own, where the helper is forked)."""
+    import multiprocessing
+
+    tmp_path = Path(tmp)
+    case, name = paper._split([("idle", name) for name in paper.FIGURES])[1][0]
+    (tmp_path / f"{case}_{name}.png").mkdir()
+    forked = []
+    start = paper._Helper.start.__func__
+
+    def spy(cls, draw, jobs):
+        helper = start(cls, draw, jobs)
+        forked.append(helper is not None)
+        return helper
+
+    paper._Helper.start = classmethod(spy)
+    try:
+        paper.main(_args(tmp_path, load="idle"))
+    except IsADirectoryError as exc:
+        assert name in str(exc)
+    else:
+        raise AssertionError("the helper's error was not raised")
+    assert forked == [True]
+    assert not multiprocessing.active_children()
+
+
+def _in_fresh_interpreter(function: str, tmp_path: Path) -> None:
     import subprocess
     import sys
 
     code = (f"import sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); "
-            f"import test_paper_figures as t; t._helper_against_alone({str(tmp_path)!r})")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+            f"import test_paper_figures as t; t.{function}({str(tmp_path)!r})")
+    proc = subprocess.run([sys.executable, "-W", "error", "-c", code], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr[-3000:]
+
+
+def test_helper_process_writes_the_same_figures_as_this_process(tmp_path) -> None:
+    # In a fresh interpreter: this test process may hold other threads (earlier tests' pools),
+    # and rvdyn paper then draws everything itself instead of forking.
+    _in_fresh_interpreter("_helper_against_alone", tmp_path)
+
+
+def test_an_error_in_the_forked_helper_reaches_the_caller(tmp_path) -> None:
+    _in_fresh_interpreter("_helper_error", tmp_path)
 
 
 def test_an_error_in_the_helper_reaches_the_caller(tmp_path) -> None:
     # A folder where the helper's PNG should go: its OSError is raised here (the CLI turns it
     # into "cannot write ..."), and the helper process is gone.
-    (tmp_path / f"idle_{paper.HELPER_FIGURES[0]}.png").mkdir()
+    case, name = paper._split([("idle", name) for name in paper.FIGURES])[1][0]
+    (tmp_path / f"{case}_{name}.png").mkdir()
     with pytest.raises(OSError):
         paper.main(_args(tmp_path, load="idle"))
     import multiprocessing

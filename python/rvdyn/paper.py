@@ -290,62 +290,59 @@ def figures(load: str, scene: Scene, result: Result, out: Path) -> list[Path]:
     return _write_figures(load, _theory(scene), result, out, FIGURES)
 
 
-#: The figures the helper process draws (the others are drawn by the calling process): about
-#: half of the drawing time, and little data to send (time, output speed, disc centre).
-HELPER_FIGURES = ("output_speed", "disc_center")
+def _split(jobs: list[tuple[str, str]]) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+    """The figure jobs ``(load case, figure)`` left when the last run is done, shared between
+    this process and the helper: every other one, in their order (the figures cost within a
+    factor of about 2 of each other)."""
+    return jobs[0::2], jobs[1::2]
 
 
-def _helper_loop(conn: Any, out: Path) -> None:
-    """Body of the helper process: import matplotlib (while the caller does the same and the
-    first run goes), then draw the figures of each job received on ``conn`` until None comes;
-    reply the files written, or the exception raised."""
+def _helper_main(conn: Any, draw: Any, jobs: list[tuple[str, str]]) -> None:
+    """Body of the helper process: draw ``jobs`` with ``draw`` (inherited by the fork, with the
+    results it reads), send back the files written or the exception raised."""
     try:
-        failed: Exception | None = None
         try:
-            _import_matplotlib()
-        except Exception as exc:  # reported with the first job
-            failed = exc
-        while (job := conn.recv()) is not None:
-            load, theory, arrays = job
-            try:
-                if failed is not None:
-                    raise failed
-                reply: Any = _write_figures(load, theory, Result(arrays, {}), out, HELPER_FIGURES)
-            except Exception as exc:  # sent back and raised by the caller
-                reply = exc
+            reply: Any = [draw(*job) for job in jobs]
+        except Exception as exc:  # sent back and raised by the caller
+            reply = exc
+        try:
             conn.send(reply)
-    except (KeyboardInterrupt, EOFError, BrokenPipeError):  # Ctrl-C or the caller gone
+        except Exception:  # an exception that does not pickle: its text
+            conn.send(RuntimeError(f"the figure process failed: {reply!r}"))
+    except (KeyboardInterrupt, BrokenPipeError):  # Ctrl-C or the caller gone
         pass
     finally:
         conn.close()
 
 
 class _Helper:
-    """A process drawing :data:`HELPER_FIGURES` while the caller draws the others.
+    """A process drawing part of the figures left once the last run is done, while the caller
+    draws the others.
 
-    Forked before any thread is started (so the child holds no lock of another thread), and
-    before matplotlib is imported, so that the runs start at once: both processes import it
-    while the first run goes. None of this where fork is not the platform's way or other
-    Python threads already run: then the caller draws all."""
+    Forked then, when the run's worker thread has ended: the child inherits matplotlib, already
+    imported, and the results, so nothing is imported twice and nothing is sent but the reply.
+    Before that moment the two cores are busy with the runs and with drawing the figures of
+    the runs done. None of this where fork is not the platform's way, with one core, or while
+    other Python threads run: then the caller draws all."""
 
     def __init__(self, proc: Any, conn: Any) -> None:
-        self.proc, self.conn, self.pending = proc, conn, 0
+        self.proc, self.conn = proc, conn
 
     @classmethod
-    def start(cls, out: Path) -> _Helper | None:
+    def start(cls, draw: Any, jobs: list[tuple[str, str]]) -> _Helper | None:
         if sys.platform != "linux" or threading.active_count() > 1 or (os.cpu_count() or 1) < 2:
             return None
         import multiprocessing
 
         try:
             ctx = multiprocessing.get_context("fork")
-            parent, child = ctx.Pipe()
-            proc = ctx.Process(target=_helper_loop, args=(child, out), name="rvdyn-paper-figures", daemon=True)
+            parent, child = ctx.Pipe(duplex=False)
+            proc = ctx.Process(target=_helper_main, args=(child, draw, jobs), name="rvdyn-paper-figures", daemon=True)
             sys.stdout.flush()  # nothing buffered may be written twice
             sys.stderr.flush()
             with warnings.catch_warnings():
                 # Python >= 3.12 warns about fork() in any process with several OS threads
-                # (numpy's BLAS pool): no Python thread runs yet and the child only draws.
+                # (numpy's BLAS pool): no other Python thread runs and the child only draws.
                 warnings.simplefilter("ignore", DeprecationWarning)
                 proc.start()
         except (OSError, ValueError):  # no fork or no pipe here: draw in this process
@@ -353,34 +350,19 @@ class _Helper:
         child.close()
         return cls(proc, parent)
 
-    def submit(self, load: str, theory: float, result: Result) -> None:
-        needed = {c for name in HELPER_FIGURES for c in FIGURES[name][1]}
-        self.conn.send((load, theory, {c: getattr(result, c) for c in needed}))
-        self.pending += 1
-
     def finish(self) -> list[Path]:
-        """Wait for the figures submitted; raise the first error the helper met."""
-        files: list[Path] = []
-        error: BaseException | None = None
+        """Wait for the helper's figures; raise the error it met."""
         try:
-            for _ in range(self.pending):
-                reply = self.conn.recv()
-                if isinstance(reply, BaseException):
-                    error = error or reply
-                else:
-                    files.extend(reply)
-            self.pending = 0
+            reply = self.conn.recv()
+        except EOFError:
+            reply = RuntimeError("the figure process ended without writing its figures")
         finally:
             self.close()
-        if error is not None:
-            raise error
-        return files
+        if isinstance(reply, BaseException):
+            raise reply
+        return list(reply)
 
     def close(self) -> None:
-        try:
-            self.conn.send(None)
-        except OSError:
-            pass
         self.conn.close()
         self.proc.join(timeout=10)
         if self.proc.is_alive():  # pragma: no cover - a helper that hangs
@@ -431,9 +413,9 @@ def markdown(summaries: list[dict[str, Any]]) -> str:
 def main(args: argparse.Namespace) -> int:
     """Entry point of ``rvdyn paper``: run the load cases, write figures and summaries.
 
-    The runs go one after the other on a worker thread (the core releases the GIL); the
-    figures of each finished run are drawn meanwhile, by this thread and by a helper process
-    (:class:`_Helper`), so that simulation and drawing share the cores."""
+    The runs go one after the other on a worker thread (the core releases the GIL) while this
+    thread imports matplotlib and draws the figures of each run done; once the last run is
+    done, a helper process (:class:`_Helper`) draws every other figure still to draw."""
     out = Path(getattr(args, "out", "rvdyn-out"))
     out.mkdir(parents=True, exist_ok=True)
     load = getattr(args, "load", "all")
@@ -445,24 +427,42 @@ def main(args: argparse.Namespace) -> int:
                          else "generalized-alpha")
     print(f"running load case{'s' if several else ''} {', '.join(map(repr, loads))}: "
           f"{t_end} s simulated{' each' if several else ''} with {how} ...", flush=True)
-    helper = _Helper.start(out)
-    mine = [name for name in FIGURES if helper is None or name not in HELPER_FIGURES]
+    done: dict[str, tuple[float, Result]] = {}
+
+    def draw(case: str, name: str) -> Path:
+        path = out / f"{case}_{name}.png"
+        theory, result = done[case]
+        _save(FIGURES[name][0](case, theory, result), path)
+        return path
+
     summaries = []
+    jobs: list[tuple[str, str]] = []
+    helper: _Helper | None = None
     pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="rvdyn-paper")
     try:
         # No progress bar: one from the worker thread would mix with the lines printed here.
-        runs = [pool.submit(run_case, case, t_end, integrator, False) for case in loads]
+        runs = list(zip(loads, [pool.submit(run_case, case, t_end, integrator, False) for case in loads]))
         _import_matplotlib()  # while the first run goes
-        for case, run in zip(loads, runs):
-            scene, result, wall = run.result()
-            if helper is not None:
-                helper.submit(case, _theory(scene), result)
-            summary = summarize(case, scene, result, wall)
-            summaries.append(summary)
-            _write_figures(case, _theory(scene), result, out, mine)
-            print(f"  {case}: mean output speed {summary['output_speed_mean_deg_s']:.6f} deg/s "
-                  f"(theory {summary['output_speed_theory_deg_s']:.6f}, error {summary['output_speed_relative_error']:.2e}), "
-                  f"simulated in {wall:.2f} s", flush=True)
+        while runs or jobs:
+            # Take the runs done; wait for one only when no figure is left to draw.
+            while runs and (runs[0][1].done() or not jobs):
+                case, run = runs.pop(0)
+                scene, result, wall = run.result()
+                done[case] = (_theory(scene), result)
+                summary = summarize(case, scene, result, wall)
+                summaries.append(summary)
+                jobs += [(case, name) for name in FIGURES]
+                print(f"  {case}: mean output speed {summary['output_speed_mean_deg_s']:.6f} deg/s "
+                      f"(theory {summary['output_speed_theory_deg_s']:.6f}, error {summary['output_speed_relative_error']:.2e}), "
+                      f"simulated in {wall:.2f} s", flush=True)
+                if not runs:
+                    pool.shutdown(wait=True)  # the worker thread ends: nothing runs but this thread
+                    jobs, theirs = _split(jobs)
+                    helper = _Helper.start(draw, theirs)
+                    if helper is None:
+                        jobs += theirs
+            if jobs:
+                draw(*jobs.pop(0))
         if helper is not None:
             helper.finish()
             helper = None
