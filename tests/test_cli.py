@@ -143,3 +143,31 @@ def test_warnings_are_one_line_each_and_once(tmp_path):
     # In the command's option names.
     r = run("analyze", "--angles", "30", "--loop-points", "9", "--out", str(tmp_path / "b"))
     assert "use --angles >= 84" in r.stderr and "use points" not in r.stderr, r.stderr
+
+
+def test_analyze_gives_the_bearings_static_safety_and_the_crank_layout(tmp_path):
+    r = run("analyze", "--angles", "12", "--loop-points", "9", "--crank-layout", "-0.06", "0.06", "-0.09",
+            "-0.02", "0.02", "--out", str(tmp_path / "rows"))
+    assert r.returncode == 0, r.stderr
+    s = json.loads((tmp_path / "rows" / "summary.json").read_text())["bearing_static_safety"]
+    assert sorted(s) == ["crank_a", "crank_b", "eccentric"]
+    # The LTCA's own numbers at the same angles (the CLI only reports them).
+    import numpy as np
+
+    import rvdyn
+
+    scene = rvdyn.Scene.physical("rated")
+    angles = rvdyn.ltca(scene, crank_angles=[0.0]).mesh_period * np.arange(12) / 12
+    layout = rvdyn.CrankLayout(bearings=(-0.06, 0.06), planet=-0.09, discs=(-0.02, 0.02))
+    with pytest.warns(RuntimeWarning, match="crank_a"):
+        want = rvdyn.ltca(scene, crank_angles=angles).bearing_safety(layout)
+    for name in s:
+        assert s[name]["static_safety"] == pytest.approx(want[name]["static_safety"], rel=1e-9)
+    assert "rvdyn analyze: warning: bearing_safety: the crank_a bearings' peak load" in r.stderr
+    assert "crank a peak" in (tmp_path / "rows" / "summary.md").read_text()
+    # Too few positions, or a scene without roller crank bearings: refused before the work.
+    r = run("analyze", "--crank-layout", "0", "1", "2", "--out", str(tmp_path / "few"))
+    assert r.returncode == 1 and "at least 4 positions" in r.stderr and not (tmp_path / "few").exists()
+    r = run("analyze", "--preset", "paper", "--crank-layout", "0", "1", "2", "3", "--out", str(tmp_path / "paper"))
+    assert r.returncode == 1 and "crank bearing built from rollers" in r.stderr
+    assert not (tmp_path / "paper").exists()

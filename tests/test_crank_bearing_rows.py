@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import rvdyn
+import rvdyn.analysis
 from rvdyn import CrankLayout, ParameterError, Scene
 
 # The rated step at t = 0 and the short window are not what these tests look at.
@@ -127,3 +128,62 @@ def test_a_layout_needs_roller_crank_bearings() -> None:
     r = rvdyn.simulate(Scene.paper("rated"), 0.002, channels=["motion", "bearings"], progress=False)
     with pytest.raises(ParameterError, match="rollers"):
         r.bearing_life(crank_layout=CrankLayout(bearings=(0.0, 0.1), discs=(0.03, 0.07), planet=-0.02))
+
+
+def _iso76_roller(rollers: dict[str, float], length: float | None = None) -> float:
+    """ISO 76:2006 clause 6.1.2, radial roller bearing (alpha 0, one row), mm units in, N out:
+    C0r = 44 (1 - Dwe/Dpw) Z Lwe Dwe."""
+    d, dpw = rollers["diameter"] * 1e3, rollers["pitch_diameter"] * 1e3
+    lwe = (rollers["length"] if length is None else length) * 1e3
+    return 44.0 * (1.0 - d / dpw) * rollers["count"] * lwe * d
+
+
+@pytest.fixture(scope="module")
+def quasi_static() -> rvdyn.analysis.LtcaResult:
+    return rvdyn.ltca(Scene.physical("rated"), crank_angles=np.linspace(0.0, 2 * math.pi, 48, endpoint=False))
+
+
+def test_ltca_bearing_safety_against_iso_76_by_hand(quasi_static: rvdyn.analysis.LtcaResult) -> None:
+    joints = quasi_static.scene["joints"]
+    s = quasi_static.bearing_safety()
+    assert sorted(s) == ["crank", "eccentric"]
+    for name, force in (("crank", quasi_static.crank_bearing_force),
+                        ("eccentric", quasi_static.eccentric_bearing_force)):
+        mag = np.linalg.norm(force, axis=-1)
+        i = np.unravel_index(np.argmax(mag), mag.shape)[0]
+        c0 = _iso76_roller(joints[f"{name}_bearing"]["rollers"])
+        assert s[name]["static_rating"] == pytest.approx(c0, rel=1e-12)
+        assert s[name]["peak_load"] == pytest.approx(mag.max(), rel=1e-14)
+        assert s[name]["crank_angle"] == quasi_static.crank_angle[i]
+        assert s[name]["static_safety"] == pytest.approx(c0 / mag.max(), rel=1e-12)
+
+
+def test_ltca_bearing_rows_closed_form_and_offset(quasi_static: rvdyn.analysis.LtcaResult) -> None:
+    lumped = quasi_static.bearing_safety()["crank"]
+    # Discs and planet in the bearings' mid-plane: each bearing carries half the lumped force,
+    # and rated with rollers of half the length (C0r linear in it), has the lumped s0.
+    mid = quasi_static.bearing_safety(CrankLayout(bearings=(-0.05, 0.05), discs=(0.0, 0.0), planet=0.0))
+    rollers = quasi_static.scene["joints"]["crank_bearing"]["rollers"]
+    for side in ("crank_a", "crank_b"):
+        assert mid[side]["peak_load"] == pytest.approx(0.5 * lumped["peak_load"], rel=1e-9)
+        assert mid[side]["static_rating"] == pytest.approx(_iso76_roller(rollers, rollers["length"] / 2), rel=1e-12)
+        assert mid[side]["static_safety"] == pytest.approx(lumped["static_safety"], rel=1e-9)
+    # The layout of docs/guide.md: the discs' tilting moment loads bearing a beyond half
+    # the lumped load, below s0 1 (warned).
+    with pytest.warns(RuntimeWarning, match="crank_a bearings' peak load .* s0 = 0.9"):
+        off = quasi_static.bearing_safety(CrankLayout(bearings=(-0.06, 0.06), discs=(-0.02, 0.02), planet=-0.09))
+    assert off["crank_a"]["static_safety"] < 1.0 < lumped["static_safety"]
+    assert off["crank_a"]["peak_load"] > 0.6 * lumped["peak_load"]
+
+
+def test_ltca_bearing_safety_needs_roller_bearings() -> None:
+    with pytest.raises(ParameterError, match="joints are rigid"):
+        rvdyn.ltca(Scene.paper("rated"), crank_angles=[0.0]).bearing_safety()
+    linear = Scene.paper("rated").with_compliant_joints()
+    with pytest.raises(ParameterError, match="no bearing of this scene is built from rollers"):
+        rvdyn.ltca(linear, crank_angles=[0.0]).bearing_safety()
+    lt = rvdyn.ltca(Scene.physical("rated"), crank_angles=[0.0])
+    bare = rvdyn.analysis.LtcaResult(torque=lt.torque, mesh_period=lt.mesh_period, ratio=lt.ratio, face_width=lt.face_width,
+                            arrays=lt.arrays, fea_csv="", fea_json="")
+    with pytest.raises(ParameterError, match="carries no scene"):
+        bare.bearing_safety()

@@ -10,7 +10,7 @@ import importlib
 
 import pytest
 
-MODULES = ["rvdyn", "rvdyn.scene", "rvdyn.simulation", "rvdyn.result", "rvdyn.bearing"]
+MODULES = ["rvdyn", "rvdyn.scene", "rvdyn.simulation", "rvdyn.result", "rvdyn.bearing", "rvdyn.analysis.ltca"]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -11,6 +11,7 @@ each one with ``crank_layout``.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -92,3 +93,17 @@ class CrankLayout:
         out = dict(scene)
         out["joints"] = {**scene["joints"], "crank_bearing": {**crank, "rollers": {**rollers, "length": length}}}
         return out
+
+
+def static_safety(caller: str, family: str, peak: float, static: float, remedy: str) -> float:
+    """ISO 76 static safety ``s0 = C0r / P0`` of the ``family`` bearings (peak radial load
+    ``peak`` [N], static rating ``static`` [N]; inf at no load), with a ``RuntimeWarning`` naming
+    ``caller`` and ``remedy`` below 1, where the raceways yield and the elastic roller law no
+    longer holds. The warning points at the caller's caller."""
+    s0 = static / peak if peak > 0 else math.inf
+    if s0 < 1.0:
+        warnings.warn(
+            f"{caller}: the {family} bearings' peak load {peak / 1e3:.1f} kN exceeds their ISO 76 static "
+            f"rating C0r = {static / 1e3:.1f} kN (static safety s0 = {s0:.2f} < 1): the raceways yield there "
+            f"and the elastic roller law and the forces do not hold; {remedy}", RuntimeWarning, stacklevel=3)
+    return s0

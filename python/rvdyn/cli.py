@@ -6,7 +6,7 @@ Subcommands::
     rvdyn plot-geometry [--out DIR] [--psi RAD]
     rvdyn plot-stiffness [--out DIR]
     rvdyn paper [--out DIR] [--t-end S] [--load {idle,paper,rated,all}] [--integrator NAME]
-    rvdyn analyze [SCENE] [--torque NM] [--angles N] [--loop-points N] [--out DIR]
+    rvdyn analyze [SCENE] [--torque NM] [--angles N] [--loop-points N] [--crank-layout Z ...] [--out DIR]
     rvdyn study SPEC.toml [--out DIR] [--samples N] [--no-plots]
     rvdyn modes [SCENE] [--torque NM] [--compliant] [--power W] [--speeds LO HI] [--out DIR]
 

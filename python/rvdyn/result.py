@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from . import _core
 from .errors import ParameterError, RvdynError
 from ._args import read_only
+from .bearing import static_safety
 from ._args import real as _real
 from ._args import whole as _whole
 from .plotting import pin_indices
@@ -406,13 +407,8 @@ class Result:
             p, l10 = lives[worst]
             rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
             peak = float(mag.max())
-            s0 = static / peak if peak > 0 else math.inf
-            if s0 < 1.0:
-                warnings.warn(
-                    f"bearing_life: the {name} bearings' peak load {peak / 1e3:.1f} kN exceeds their ISO 76 "
-                    f"static rating C0r = {static / 1e3:.1f} kN (static safety s0 = {s0:.2f} < 1): the raceways "
-                    "yield there and the elastic roller law, the forces and the life do not hold; use larger "
-                    "bearings (joints.*.rollers) or a lower load", RuntimeWarning, stacklevel=2)
+            s0 = static_safety("bearing_life", name, peak, static,
+                               "nor does the rating life; use larger bearings (joints.*.rollers) or a lower load")
             out[name] = {"peak_load": peak, "equivalent_load": p, "rating": float(rating),
                          "static_rating": float(static), "static_safety": s0,
                          "l10_million_revolutions": l10,

@@ -8,6 +8,10 @@ import json
 import math
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..scene import Scene
 
 __all__ = ["add_arguments", "run"]
 
@@ -29,10 +33,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "1e-3 N m); raise it if the unloaded TE finds no equilibrium")
     p.add_argument("--loop-points", type=int, default=201, metavar="N",
                    help="points of the torque-twist loop (default 201)")
+    p.add_argument("--crank-layout", type=float, nargs="+", default=None, metavar="Z",
+                   help="axial positions [m] of each crank's two bearings, its planet gear and the discs, "
+                   "in this order (e.g. -0.06 0.06 -0.09 -0.02 0.02): the crank bearing's static safety "
+                   "is then given for each of the two bearings (rvdyn.CrankLayout) instead of the "
+                   "lumped one")
     from ..cli import _folder
 
     p.add_argument("--out", default="rvdyn-out", metavar="DIR", type=_folder,
                    help="output folder (default rvdyn-out)")
+
+
+def _core_ratings(scene: Scene) -> tuple[float | None, float | None]:
+    """The scene's ISO 76 static ratings (eccentric, crank) [N], None where no rollers."""
+    return scene._compiled.bearing_ratings("static")
 
 
 def _progress(done: int, total: int) -> None:
@@ -64,6 +78,16 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--torque must be a finite, non-zero output torque [N m], got {args.torque}")
     if args.loop_points < 8:
         raise ParameterError(f"--loop-points must be at least 8, got {args.loop_points}")
+    layout = None
+    if args.crank_layout is not None:
+        from ..bearing import CrankLayout
+
+        z = args.crank_layout
+        if len(z) < 4:
+            raise ParameterError(f"--crank-layout needs the two bearings, the planet and at least one disc "
+                                 f"(at least 4 positions [m]), got {len(z)}")
+        layout = CrankLayout(bearings=(z[0], z[1]), planet=z[2], discs=tuple(z[3:]))
+        layout.row_scene(scene.to_dict())  # a crank bearing built from rollers, checked before the work
     if args.torque is None and scene["load.kind"] != "constant":
         raise ParameterError(f"the scene's load is {scene['load.kind']!r}, not a constant torque: give --torque N_M")
     out = Path(args.out)
@@ -85,6 +109,10 @@ def run(args: argparse.Namespace) -> int:
         save_figure(loop.plot(), str(out / "torque_twist.png")),
     ]
     csv_path, json_path = res.save_fea_loads(out)
+    # Static safety at this torque where the bearings are built from rollers (ISO 76).
+    rated = bool(res.crank_bearing_force.size) and any(
+        c is not None for c in _core_ratings(scene))
+    bearings = res.bearing_safety(layout) if rated else {}
     pp = te.peak_to_peak()
     harmonics = te.harmonics("forward", 3)
     summary = {
@@ -107,6 +135,7 @@ def run(args: argparse.Namespace) -> int:
         "te_mean_arcmin": {"forward": float(te.forward.mean()) / ARCMIN,
                            "reverse": float(te.reverse.mean()) / ARCMIN},
         **loop.summary(),
+        "bearing_static_safety": bearings,
         "files": [*files, str(csv_path), str(json_path)],
     }
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
@@ -132,6 +161,11 @@ def run(args: argparse.Namespace) -> int:
         f"{summary['lost_motion_arcmin']:.3f} arcmin, backlash {summary['backlash_arcmin']:.3f} arcmin "
         f"(the loop runs to +-{abs(res.torque):.1f} N m, taken as the rated torque: rigidity between "
         f"the +-rated points, lost motion within +-3 % of it)",
+        *([("- bearings at this torque (ISO 76 static safety s0 = C0r / peak load): " + "; ".join(
+            f"{name.replace('_', ' ')} peak {b['peak_load'] / 1e3:.1f} kN, C0r {b['static_rating'] / 1e3:.1f} kN, "
+            f"s0 {b['static_safety']:.2f}" for name, b in bearings.items())
+            + (" (crank a and b: the two bearings of --crank-layout, each with rollers of half the lumped "
+               "length)" if layout is not None else ""))] if bearings else []),
         f"- equilibrium: torque balance <= {summary['torque_balance_max']:.1e}, residual <= "
         f"{summary['residual_max']:.1e} (relative)",
         *([f"- friction (pins {fr['pin']:g}, teeth {fr['mesh']:g}"

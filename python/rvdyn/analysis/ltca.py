@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -17,6 +18,7 @@ from .._args import whole as _whole
 from ..scene import Scene
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ..bearing import CrankLayout
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
@@ -76,7 +78,9 @@ class LtcaResult:
     with the pin loads; empty for rigid joints); ``torque_balance``, ``residual`` (n,) relative
     (to the torque and the load scale; near the smallest torque an equilibrium resolves they are
     set by the round-off of the contact forces, about 1e-5 at 1e-3 N m on the paper scene);
-    ``iterations`` (n,); ``torsional_stiffness`` (n,) [N m/rad].
+    ``iterations`` (n,); ``torsional_stiffness`` (n,) [N m/rad]. ``scene``: the analysed scene
+    as a dict (:meth:`rvdyn.Scene.to_dict`; None for a result built by hand), whose bearing
+    ratings :meth:`bearing_safety` reads.
     """
 
     torque: float
@@ -86,6 +90,7 @@ class LtcaResult:
     arrays: dict[str, np.ndarray] = field(repr=False)
     fea_csv: str = field(repr=False)
     fea_json: str = field(repr=False)
+    scene: dict[str, Any] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "arrays", {k: read_only(np.asarray(v)) for k, v in self.arrays.items()})
@@ -118,6 +123,64 @@ class LtcaResult:
             "residual_max": float(a["residual"].max()),
             "peak_pressure_max_Pa": float(a["peak_pressure"].max()),
         }
+
+    def bearing_safety(self, crank_layout: CrankLayout | None = None) -> dict[str, dict[str, float]]:
+        """ISO 76 static safety of the most loaded bearing of each family over these crank
+        angles: ``peak_load`` [N], the ``crank_angle`` [rad] where it occurs, the static rating
+        ``static_rating`` ``C0r`` [N] and ``static_safety`` ``s0 = C0r / peak_load`` (a
+        ``RuntimeWarning`` below 1: the raceways yield there, and the elastic roller law and
+        the forces no longer hold). Families ``"eccentric"`` and ``"crank"``; with
+        ``crank_layout`` (:class:`rvdyn.CrankLayout`, axial positions [m]) ``"crank"`` is
+        replaced by the crank's two bearings ``"crank_a"`` and ``"crank_b"``
+        (:func:`rvdyn.crank_bearing_rows`, exact here: no inertia force), each rated with
+        rollers of ``crank_layout.roller_length`` (default half the lumped length). The rating
+        life needs the duty cycle: :meth:`rvdyn.Result.bearing_life` gives it for a run.
+
+        ``ParameterError`` if the result carries no scene, its joints are rigid (no bearing
+        forces) or none of its bearings is built from rollers (no ``C0r``); a family without
+        rollers is left out.
+
+        >>> import rvdyn
+        >>> lt = rvdyn.ltca(rvdyn.Scene.physical("rated"), crank_angles=[0.0])
+        >>> s = lt.bearing_safety()
+        >>> sorted(s), round(s["crank"]["static_safety"], 2) > 1
+        (['crank', 'eccentric'], True)
+        """
+        from ..bearing import static_safety
+
+        if self.scene is None:
+            raise ParameterError("this LtcaResult carries no scene, so no bearing rating: take it from rvdyn.ltca")
+        crank_force = self.arrays["crank_bearing_force"]
+        ecc_force = self.arrays["eccentric_bearing_force"]
+        if crank_force.size == 0:
+            raise ParameterError("the scene's joints are rigid, so the LTCA has no bearing forces: give "
+                                 "compliant joints with rollers (joints.*.rollers), as Scene.physical has")
+        s_ecc, s_crank = _core.CompiledScene.from_json(json.dumps(self.scene)).bearing_ratings("static")
+        if s_ecc is None and s_crank is None:
+            raise ParameterError(
+                "no bearing of this scene is built from rollers, so there is no ISO 76 static rating: give "
+                "joints.eccentric_bearing.rollers (and joints.crank_bearing.rollers), as Scene.physical "
+                "does; the bearing forces are in eccentric_bearing_force and crank_bearing_force")
+        families: list[tuple[str, float | None, np.ndarray]] = [("eccentric", s_ecc, ecc_force)]
+        if crank_layout is None:
+            families.append(("crank", s_crank, crank_force))
+        else:
+            row = _core.CompiledScene.from_json(json.dumps(crank_layout.row_scene(self.scene)))
+            s_row = row.bearing_ratings("static")[1]
+            rows = crank_layout.rows(crank_force, ecc_force)
+            families += [(f"crank_{side}", s_row, rows[:, :, j]) for j, side in enumerate("ab")]
+        out: dict[str, dict[str, float]] = {}
+        for name, static, forces in families:
+            if static is None:
+                continue
+            mag = np.linalg.norm(forces, axis=-1)
+            at = np.unravel_index(int(np.argmax(mag)), mag.shape)
+            peak = float(mag[at])
+            s0 = static_safety("bearing_safety", name, peak, static,
+                               "use larger bearings (joints.*.rollers) or a lower torque")
+            out[name] = {"peak_load": peak, "crank_angle": float(self.arrays["crank_angle"][at[0]]),
+                         "static_rating": float(static), "static_safety": s0}
+        return out
 
     def worst_index(self, disc: int = 0) -> int:
         """Index of the crank angle with the largest pin force on ``disc``."""
@@ -495,7 +558,7 @@ def ltca(scene: Scene, torque: float | None = None, crank_angles: Sequence[float
     fea_csv, fea_json = solver.fea_loads()
     return LtcaResult(torque=t, mesh_period=float(solver.mesh_period), ratio=float(solver.ratio),
                       face_width=float(solver.face_width), arrays=arrays, fea_csv=fea_csv,
-                      fea_json=fea_json)
+                      fea_json=fea_json, scene=sc.to_dict())
 
 
 def tooth_mesh_angles(scene: Scene) -> int:
