@@ -112,6 +112,9 @@ def test_bad_layouts_and_inputs_are_refused() -> None:
         ({"bearings": (0.0, 0.1, 0.2), "discs": (0.0,), "planet": 0.0}, "two crank bearings"),
         ({"bearings": (0.0, 0.1), "discs": ("a",), "planet": 0.0}, "metres"),
         ({"bearings": (0.0, 0.1), "discs": (0.0,), "planet": 0.0, "roller_length": -0.02}, "roller_length"),
+        # The hypothesis suite found an int beyond the floats raising OverflowError here.
+        ({"bearings": (0.0, 0.1), "discs": (0.0,), "planet": 0.0, "roller_length": 10**400}, "roller_length"),
+        ({"bearings": (0.0, 0.1), "discs": (0.0,), "planet": 0.0, "roller_length": True}, "roller_length"),
     ):
         with pytest.raises(ParameterError, match=match):
             CrankLayout(**kwargs)  # type: ignore[arg-type]

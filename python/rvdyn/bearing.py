@@ -64,8 +64,14 @@ class CrankLayout:
             raise ParameterError(f"CrankLayout.bearings must hold the two crank bearings' positions [m], "
                                  f"got {len(bearings)}")
         length = self.roller_length
-        if length is not None and not (isinstance(length, (int, float)) and math.isfinite(length) and length > 0):
-            raise ParameterError(f"CrankLayout.roller_length must be a positive length [m] or None, got {length!r}")
+        if length is not None:
+            try:
+                value = float(length) if isinstance(length, (int, float)) and not isinstance(length, bool) else math.nan
+            except OverflowError:  # an int beyond the floats
+                value = math.nan
+            if not (math.isfinite(value) and value > 0):
+                raise ParameterError(f"CrankLayout.roller_length must be a positive length [m] or None, got {length!r}")
+            object.__setattr__(self, "roller_length", value)
         object.__setattr__(self, "bearings", bearings)
         object.__setattr__(self, "discs", discs)
         object.__setattr__(self, "planet", planet)
