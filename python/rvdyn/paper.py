@@ -430,10 +430,7 @@ def main(args: argparse.Namespace) -> int:
     done: dict[str, tuple[float, Result]] = {}
 
     def draw(case: str, name: str) -> Path:
-        path = out / f"{case}_{name}.png"
-        theory, result = done[case]
-        _save(FIGURES[name][0](case, theory, result), path)
-        return path
+        return _write_figures(case, *done[case], out, [name])[0]
 
     summaries = []
     jobs: list[tuple[str, str]] = []

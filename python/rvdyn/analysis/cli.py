@@ -8,11 +8,6 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:  # pragma: no cover
-    from ..scene import Scene
-
 __all__ = ["add_arguments", "run"]
 
 
@@ -42,11 +37,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
     p.add_argument("--out", default="rvdyn-out", metavar="DIR", type=_folder,
                    help="output folder (default rvdyn-out)")
-
-
-def _core_ratings(scene: Scene) -> tuple[float | None, float | None]:
-    """The scene's ISO 76 static ratings (eccentric, crank) [N], None where no rollers."""
-    return scene._compiled.bearing_ratings("static")
 
 
 def _progress(done: int, total: int) -> None:
@@ -110,8 +100,7 @@ def run(args: argparse.Namespace) -> int:
     ]
     csv_path, json_path = res.save_fea_loads(out)
     # Static safety at this torque where the bearings are built from rollers (ISO 76).
-    rated = bool(res.crank_bearing_force.size) and any(
-        c is not None for c in _core_ratings(scene))
+    rated = res.crank_bearing_force.size and any(c is not None for c in scene._compiled.bearing_ratings("static"))
     bearings = res.bearing_safety(layout) if rated else {}
     pp = te.peak_to_peak()
     harmonics = te.harmonics("forward", 3)
