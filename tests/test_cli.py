@@ -6,6 +6,7 @@ import importlib.util
 import json
 import subprocess
 import sys
+import warnings
 
 import pytest
 
@@ -171,3 +172,20 @@ def test_analyze_gives_the_bearings_static_safety_and_the_crank_layout(tmp_path)
     r = run("analyze", "--preset", "paper", "--crank-layout", "0", "1", "2", "3", "--out", str(tmp_path / "paper"))
     assert r.returncode == 1 and "crank bearing built from rollers" in r.stderr
     assert not (tmp_path / "paper").exists()
+    # The same layout carried by the scene file (field crank_layout, 20 mm rollers): taken
+    # without the option, and named in the summaries.
+    path = scene.replace(crank_layout={"bearings": [-0.06, 0.06], "planet": -0.09, "discs": [-0.02, 0.02],
+                                       "roller_length": 0.02}).save(tmp_path / "laid_out.toml")
+    r = run("analyze", str(path), "--angles", "12", "--loop-points", "9", "--out", str(tmp_path / "carried"))
+    assert r.returncode == 0, r.stderr
+    summary = json.loads((tmp_path / "carried" / "summary.json").read_text())
+    assert summary["crank_layout"] == {"bearings": [-0.06, 0.06], "discs": [-0.02, 0.02], "planet": -0.09,
+                                       "roller_length": 0.02}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        want = rvdyn.ltca(scene, crank_angles=angles).bearing_safety(
+            rvdyn.CrankLayout(bearings=(-0.06, 0.06), planet=-0.09, discs=(-0.02, 0.02), roller_length=0.02))
+    for name in ("crank_a", "crank_b", "eccentric"):
+        assert summary["bearing_static_safety"][name]["static_safety"] == pytest.approx(
+            want[name]["static_safety"], rel=1e-9)
+    assert "from the scene's crank_layout, each with rollers of 20 mm" in (tmp_path / "carried" / "summary.md").read_text()

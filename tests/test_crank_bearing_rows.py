@@ -4,6 +4,7 @@ ratings of one row, Lundberg-Palmgren system life."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 
@@ -190,3 +191,50 @@ def test_ltca_bearing_safety_needs_roller_bearings() -> None:
                             arrays=lt.arrays, fea_csv="", fea_json="")
     with pytest.raises(ParameterError, match="carries no scene"):
         bare.bearing_safety()
+
+
+# --- the layout carried by the scene (field crank_layout, docs/scene.md) ---------------------
+LAYOUT = {"bearings": [-0.06, 0.06], "discs": [-0.02, 0.02], "planet": -0.09}
+
+
+def test_a_scene_carries_its_crank_layout_and_the_analyses_take_it(
+        run: rvdyn.Result, quasi_static: rvdyn.analysis.LtcaResult) -> None:
+    scene = Scene.physical("rated").replace(crank_layout={**LAYOUT, "roller_length": 0.018})
+    assert scene["crank_layout.roller_length"] == 0.018
+    # It survives the scene file, and is checked when read.
+    assert Scene.from_toml(scene.to_toml()) == scene == Scene.from_json(scene.to_json())
+    layout = CrankLayout.of_scene(scene.to_dict())
+    assert layout == CrankLayout(bearings=(-0.06, 0.06), discs=(-0.02, 0.02), planet=-0.09, roller_length=0.018)
+    # The LTCA and the run take it by default: the same numbers as with the layout given.
+    lt = dataclasses.replace(quasi_static, scene=scene.to_dict())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # s0 below 1 at this layout
+        assert lt.bearing_safety() == quasi_static.bearing_safety(layout)
+        assert sorted(lt.bearing_safety()) == ["crank_a", "crank_b", "eccentric"]
+        carried = rvdyn.Result(run._arrays, run.stats, scene=scene.to_dict(), options=run.options)
+        assert carried.bearing_life(t_start=0.01) == run.bearing_life(t_start=0.01, crank_layout=layout)
+    # Without one: the lumped row, as before.
+    assert CrankLayout.of_scene(Scene.physical("rated").to_dict()) is None
+    assert sorted(quasi_static.bearing_safety()) == ["crank", "eccentric"]
+
+
+def test_a_scene_layout_without_roller_crank_bearings_is_kept_but_not_rated() -> None:
+    # Geometry is valid on any joints; rows are rated only where the crank bearing has rollers.
+    scene = Scene.paper("rated").with_compliant_joints().replace(crank_layout=LAYOUT)
+    assert scene["crank_layout.planet"] == -0.09
+    assert CrankLayout.of_scene(scene.to_dict()) is None
+
+
+@pytest.mark.parametrize(("layout", "match"), [
+    ({**LAYOUT, "discs": [0.0]}, r"crank_layout\.discs needs the axial position \[m\] of each of the scene's 2 discs"),
+    ({**LAYOUT, "bearings": [0.05, 0.05]}, "crank_layout: the two crank bearings must be at different"),
+    ({**LAYOUT, "roller_length": 0.0}, r"crank_layout: .*roller_length must be in \(0, 1\] m"),
+    ({**LAYOUT, "roller_length": 2.0}, r"roller_length must be in \(0, 1\] m"),
+    ({**LAYOUT, "discs": []}, "crank_layout: the crank layout needs the axial position of every disc"),
+    ({"bearings": [-0.06, 0.06], "discs": [0.0, 0.0]}, "planet"),
+    ({**LAYOUT, "bearing": [0.0, 1.0]}, "bearing"),
+    ({**LAYOUT, "bearings": [0.0, 0.1, 0.2]}, "bearings"),
+])
+def test_a_bad_scene_layout_is_a_scene_error_naming_the_field(layout: dict[str, object], match: str) -> None:
+    with pytest.raises(rvdyn.SceneError, match=match):
+        Scene.physical("rated").replace(crank_layout=layout)

@@ -4,8 +4,9 @@ The planar models carry each crank on one lumped bearing. The two bearings of a 
 share its load unequally, because the two discs' eccentric loads point in different directions
 and act at different axial positions: a tilting moment the plane cannot see. Given the axial
 layout, the statics of a rigid crank on two radial supports (statically determinate) give each
-bearing's load (docs/model.md, "Crank bearing rows"); :meth:`rvdyn.Result.bearing_life` rates
-each one with ``crank_layout``.
+bearing's load (docs/model.md, "Crank bearing rows"); :meth:`rvdyn.Result.bearing_life` and
+:meth:`rvdyn.analysis.ltca.LtcaResult.bearing_safety` rate each one with a ``crank_layout``,
+given to them or carried by the scene (its field ``crank_layout``, docs/scene.md).
 """
 
 from __future__ import annotations
@@ -86,6 +87,25 @@ class CrankLayout:
         b = self.bearings
         return _core.crank_bearing_rows(crank_bearing_force, eccentric_bearing_force, bearings=(b[0], b[1]),
                                         discs=self.discs, planet=self.planet)
+
+    @classmethod
+    def of_scene(cls, scene: dict[str, Any]) -> CrankLayout | None:
+        """The layout a scene carries (``crank_layout``, docs/scene.md; ``scene`` a dict as
+        :meth:`rvdyn.Scene.to_dict` gives), or None if it carries none or its crank bearing is
+        not built from rollers (nothing to rate row by row).
+
+        >>> import rvdyn
+        >>> scene = rvdyn.Scene.physical("rated").replace(
+        ...     crank_layout={"bearings": [-0.06, 0.06], "discs": [-0.02, 0.02], "planet": -0.09})
+        >>> CrankLayout.of_scene(scene.to_dict()).bearings
+        (-0.06, 0.06)
+        """
+        spec = scene.get("crank_layout")
+        crank = (scene.get("joints") or {}).get("crank_bearing")
+        if not spec or not (isinstance(crank, dict) and crank.get("rollers")):
+            return None
+        return cls(bearings=tuple(spec["bearings"]), discs=tuple(spec["discs"]), planet=spec["planet"],
+                   roller_length=spec.get("roller_length"))
 
     def row_scene(self, scene: dict[str, Any]) -> dict[str, Any]:
         """A copy of ``scene`` (a dict) whose crank bearing is one of the two rows: rollers of

@@ -337,7 +337,8 @@ class Result:
         scene whose bearings are built from rollers (``rollers``): ``ParameterError`` if none is;
         a bearing family without rollers is left out.
 
-        ``crank_layout`` (:class:`rvdyn.bearing.CrankLayout`, axial positions [m]) splits each
+        ``crank_layout`` (:class:`rvdyn.bearing.CrankLayout`, axial positions [m]; default the
+        scene's ``crank_layout`` where it has one and its crank bearing has rollers) splits each
         crank's lumped bearing into its two bearings by the statics of the rigid crank
         (:func:`rvdyn.crank_bearing_rows`): the entry ``"crank"`` is then replaced by
         ``"crank_a"`` and ``"crank_b"`` (the bearings at ``crank_layout.bearings[0]`` and
@@ -382,6 +383,10 @@ class Result:
         families: list[tuple[str, float | None, float | None, NDArray[np.float64], NDArray[np.float64]]] = [
             ("eccentric", c_ecc, s_ecc, self.eccentric_bearing_force[i0:],
              crank[:, :, None] - self.disc_angle[i0:][:, None, :])]
+        if crank_layout is None:
+            from .bearing import CrankLayout
+
+            crank_layout = CrankLayout.of_scene(self.scene)
         if crank_layout is None:
             families.append(("crank", c_crank, s_crank, self.crank_bearing_force[i0:], crank_rel))
         else:

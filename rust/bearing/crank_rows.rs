@@ -5,10 +5,14 @@
 //!
 //! Theory: docs/model.md, "Crank bearing rows".
 
+use serde::{Deserialize, Serialize};
+
 use crate::error::{Result, RvdynError, num};
 
-/// Axial positions [m] along the crank axis (any origin, one direction for all).
-#[derive(Clone, Debug, PartialEq)]
+/// Axial positions [m] along the crank axis (any origin, one direction for all), and the
+/// roller length of each of the two bearings; a scene may carry one (`crank_layout`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CrankLayout {
     /// The two crank bearings, `[z_a, z_b]`, at different positions.
     pub bearings: [f64; 2],
@@ -18,16 +22,22 @@ pub struct CrankLayout {
     /// is put there too (an error of `m_cr |p''| |z_c - z_planet| / span` per bearing; none
     /// in the quasi-static LTCA).
     pub planet: f64,
+    /// Roller length of each of the two bearings \[m\] for their load ratings; `None`: half
+    /// the scene's lumped crank roller length (the lumped row stands for two equal bearings).
+    #[serde(default)]
+    pub roller_length: Option<f64>,
 }
 
 impl CrankLayout {
-    /// Check the positions. Errors (`Parameter`): a position that is not finite, no disc, or
-    /// the two bearings closer than `1e-9` of the layout's largest distance (no support
-    /// against tilting).
+    /// Check the positions. Errors (`Parameter`): a position that is not finite, no disc, the
+    /// two bearings closer than `1e-9` of the layout's largest distance (no support against
+    /// tilting), or a roller length that is not in (0, 1] m.
     ///
     /// ```
     /// use rvdyn::bearing::CrankLayout;
-    /// let layout = CrankLayout { bearings: [-0.06, 0.06], discs: vec![-0.02, 0.02], planet: -0.09 };
+    /// let layout = CrankLayout {
+    ///     bearings: [-0.06, 0.06], discs: vec![-0.02, 0.02], planet: -0.09, roller_length: None,
+    /// };
     /// assert!(layout.validate().is_ok());
     /// let flat = CrankLayout { bearings: [0.06, 0.06], ..layout };
     /// assert!(flat.validate().is_err());
@@ -60,6 +70,15 @@ impl CrankLayout {
                 num(self.bearings[1])
             )));
         }
+        if let Some(l) = self.roller_length
+            && !(l.is_finite() && l > 0.0 && l <= 1.0)
+        {
+            return Err(RvdynError::Parameter(format!(
+                "the crank bearings' roller_length must be in (0, 1] m, or null for half the \
+                 lumped crank roller length, got {}",
+                num(l)
+            )));
+        }
         Ok(())
     }
 
@@ -74,7 +93,9 @@ impl CrankLayout {
     /// ```
     /// use rvdyn::bearing::CrankLayout;
     /// // Everything at one plane a quarter of the span from bearing a: the lever rule.
-    /// let layout = CrankLayout { bearings: [0.0, 0.1], discs: vec![0.025, 0.025], planet: 0.025 };
+    /// let layout = CrankLayout {
+    ///     bearings: [0.0, 0.1], discs: vec![0.025, 0.025], planet: 0.025, roller_length: None,
+    /// };
     /// let [a, b] = layout.split([4000.0, 0.0], &[[1000.0, 0.0], [2000.0, 0.0]]);
     /// assert!((a[0] - 3000.0).abs() < 1e-9 && (b[0] - 1000.0).abs() < 1e-9);
     /// ```
@@ -105,6 +126,7 @@ mod tests {
             bearings: [-0.06, 0.07],
             discs: vec![-0.021, 0.019],
             planet: -0.095,
+            roller_length: None,
         }
     }
 
@@ -143,6 +165,7 @@ mod tests {
             bearings: [-0.05, 0.05],
             discs: vec![-0.02, 0.02],
             planet: 0.3,
+            roller_length: None,
         };
         let [a, b] = l.split([0.0, 0.0], &[[1000.0, 0.0], [-1000.0, 0.0]]);
         // Disc forces on the crank: -1000 at -0.02, +1000 at +0.02: couple 40 N m.

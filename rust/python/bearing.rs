@@ -124,6 +124,7 @@ fn crank_bearing_rows<'py>(
         bearings: [bearings.0.0, bearings.1.0],
         discs: discs.iter().map(|z| z.0).collect(),
         planet: planet.0,
+        roller_length: None,
     };
     layout.validate()?;
     let crank = Input::finite("crank_bearing_force", "N", &crank_bearing_force)?;

@@ -4,6 +4,7 @@ directions, torque-twist loop, contact pressure, loads for FEA, summary)."""
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import sys
@@ -32,7 +33,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="axial positions [m] of each crank's two bearings, its planet gear and the discs, "
                    "in this order (e.g. -0.06 0.06 -0.09 -0.02 0.02): the crank bearing's static safety "
                    "is then given for each of the two bearings (rvdyn.CrankLayout) instead of the "
-                   "lumped one")
+                   "lumped one (default: the scene's crank_layout, if it has one)")
     from ..cli import _folder
 
     p.add_argument("--out", default="rvdyn-out", metavar="DIR", type=_folder,
@@ -68,10 +69,10 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--torque must be a finite, non-zero output torque [N m], got {args.torque}")
     if args.loop_points < 8:
         raise ParameterError(f"--loop-points must be at least 8, got {args.loop_points}")
-    layout = None
-    if args.crank_layout is not None:
-        from ..bearing import CrankLayout
+    from ..bearing import CrankLayout
 
+    layout = CrankLayout.of_scene(scene.to_dict())  # the scene's, unless --crank-layout is given
+    if args.crank_layout is not None:
         z = args.crank_layout
         if len(z) < 4:
             raise ParameterError(f"--crank-layout needs the two bearings, the planet and at least one disc "
@@ -125,6 +126,8 @@ def run(args: argparse.Namespace) -> int:
                            "reverse": float(te.reverse.mean()) / ARCMIN},
         **loop.summary(),
         "bearing_static_safety": bearings,
+        # The layout that split the crank bearing into crank_a and crank_b [m], if any.
+        "crank_layout": dataclasses.asdict(layout) if layout is not None and bearings else None,
         "files": [*files, str(csv_path), str(json_path)],
     }
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
@@ -153,8 +156,11 @@ def run(args: argparse.Namespace) -> int:
         *([("- bearings at this torque (ISO 76 static safety s0 = C0r / peak load): " + "; ".join(
             f"{name.replace('_', ' ')} peak {b['peak_load'] / 1e3:.1f} kN, C0r {b['static_rating'] / 1e3:.1f} kN, "
             f"s0 {b['static_safety']:.2f}" for name, b in bearings.items())
-            + (" (crank a and b: the two bearings of --crank-layout, each with rollers of half the lumped "
-               "length)" if layout is not None else ""))] if bearings else []),
+            + (" (crank a and b: the two bearings of the crank layout, from "
+               + ("--crank-layout" if args.crank_layout is not None else "the scene's crank_layout")
+               + ", each with rollers of "
+               + ("half the lumped length" if layout.roller_length is None else f"{layout.roller_length * 1e3:g} mm")
+               + ")" if layout is not None else ""))] if bearings else []),
         f"- equilibrium: torque balance <= {summary['torque_balance_max']:.1e}, residual <= "
         f"{summary['residual_max']:.1e} (relative)",
         *([f"- friction (pins {fr['pin']:g}, teeth {fr['mesh']:g}"

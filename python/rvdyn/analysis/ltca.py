@@ -130,7 +130,8 @@ class LtcaResult:
         ``static_rating`` ``C0r`` [N] and ``static_safety`` ``s0 = C0r / peak_load`` (a
         ``RuntimeWarning`` below 1: the raceways yield there, and the elastic roller law and
         the forces no longer hold). Families ``"eccentric"`` and ``"crank"``; with
-        ``crank_layout`` (:class:`rvdyn.CrankLayout`, axial positions [m]) ``"crank"`` is
+        ``crank_layout`` (:class:`rvdyn.CrankLayout`, axial positions [m]; default the scene's
+        ``crank_layout`` where it has one and its crank bearing has rollers) ``"crank"`` is
         replaced by the crank's two bearings ``"crank_a"`` and ``"crank_b"``
         (:func:`rvdyn.crank_bearing_rows`, exact here: no inertia force), each rated with
         rollers of ``crank_layout.roller_length`` (default half the lumped length). The rating
@@ -162,6 +163,10 @@ class LtcaResult:
                 "joints.eccentric_bearing.rollers (and joints.crank_bearing.rollers), as Scene.physical "
                 "does; the bearing forces are in eccentric_bearing_force and crank_bearing_force")
         families: list[tuple[str, float | None, np.ndarray]] = [("eccentric", s_ecc, ecc_force)]
+        if crank_layout is None:
+            from ..bearing import CrankLayout
+
+            crank_layout = CrankLayout.of_scene(self.scene)
         if crank_layout is None:
             families.append(("crank", s_crank, crank_force))
         else:

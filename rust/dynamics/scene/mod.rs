@@ -895,6 +895,10 @@ pub struct Scene {
     /// Output and drive shafts (default: rigid connections).
     #[serde(default)]
     pub shafts: Shafts,
+    /// Where the crank's bearings, discs and planet sit along its axis, to split the models'
+    /// lumped crank bearing into its two bearings (default: none, the lumped row only).
+    #[serde(default)]
+    pub crank_layout: Option<crate::bearing::CrankLayout>,
     /// The input drive.
     pub drive: Drive,
     /// The load on the output.
@@ -944,8 +948,16 @@ impl Scene {
     /// naming its path, in internally tagged enums too (where serde's `deny_unknown_fields`
     /// does not reach).
     pub fn from_value(v: &serde_json::Value) -> Result<Self> {
-        let s: Scene = serde_json::from_value(v.clone())
-            .map_err(|e| RvdynError::Scene(format!("invalid scene: {e}")))?;
+        // The path of the value serde could not read, not only what was wrong with it.
+        let s: Scene = serde_path_to_error::deserialize(v.clone()).map_err(|e| {
+            let path = e.path().to_string();
+            let at = if path == "." {
+                String::new()
+            } else {
+                format!("{path}: ")
+            };
+            RvdynError::Scene(format!("invalid scene: {at}{}", e.inner()))
+        })?;
         let normal = s.to_value()?;
         unknown_fields(v, &normal, "")?;
         s.validate()?;

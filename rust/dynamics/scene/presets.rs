@@ -155,6 +155,7 @@ impl Scene {
             errors: AssemblyErrors::default(),
             gear_errors: GearErrors::default(),
             shafts: Shafts::default(),
+            crank_layout: None,
             contact: ContactLaws {
                 pin: ContactLawSpec::paper(),
                 mesh: ContactLawSpec::paper(),

@@ -1080,6 +1080,51 @@ pub static FIELDS: &[Field] = &[
         "cumulative pitch deviation of each tooth on the reference circle (tooth k at 2 pi k / z, linear in between, periodic; positive = ahead)",
     ),
     f(
+        "crank_layout",
+        "",
+        "object or null",
+        "-",
+        NULL,
+        "",
+        "axial layout of each crankshaft (null = the lumped crank bearing row only); the analyses split the lumped row into the two bearings with it (docs/model.md, Crank bearing rows)",
+    ),
+    f(
+        "crank_layout.bearings",
+        "",
+        "list of 2 numbers",
+        "m",
+        REQ,
+        "finite, apart by more than 1e-9 of the layout's extent",
+        "mid-planes of the two crank bearings (a and b), along the crank axis (any origin, one direction)",
+    ),
+    f(
+        "crank_layout.discs",
+        "",
+        "list of numbers",
+        "m",
+        REQ,
+        "finite; one per disc, in their order",
+        "mid-planes of the discs (their eccentrics)",
+    ),
+    f(
+        "crank_layout.planet",
+        "",
+        "number",
+        "m",
+        REQ,
+        "finite",
+        "mid-plane of the planet, where the mesh force acts",
+    ),
+    f(
+        "crank_layout.roller_length",
+        "",
+        "number or null",
+        "m",
+        NULL,
+        "(0, 1]",
+        "roller length of each of the two bearings, for their ISO 76/281 ratings (null = half the lumped crank roller length)",
+    ),
+    f(
         "shafts",
         "",
         "object",
@@ -1354,6 +1399,8 @@ mod tests {
         v["joints"]["eccentric_bearing"]["damping"] = json!(1e3);
         v["joints"]["crank_bearing"]["stiffness"] = json!(1e8);
         v["joints"]["crank_bearing"]["damping"] = json!(1e3);
+        v["crank_layout"] = json!({"bearings": [-0.06, 0.06], "discs": [-0.02, 0.02],
+            "planet": -0.09, "roller_length": 0.02});
         out.push(v.clone());
         v["contact"]["pin"]["damping"] = json!({"kind": "restitution", "model": "exact",
             "restitution": 0.8, "reference_speed": 0.1});

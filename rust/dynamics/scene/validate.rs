@@ -229,6 +229,19 @@ impl Scene {
                     .into(),
             );
         }
+        if let Some(layout) = &self.crank_layout {
+            layout
+                .validate()
+                .map_err(|e| RvdynError::Scene(format!("crank_layout: {e}")))?;
+            if layout.discs.len() != self.discs.len() {
+                return err(format!(
+                    "crank_layout.discs needs the axial position [m] of each of the scene's {} \
+                     discs, in their order; got {}",
+                    self.discs.len(),
+                    layout.discs.len()
+                ));
+            }
+        }
         self.errors.check(
             self.cranks as usize,
             self.discs.len(),
