@@ -3,8 +3,10 @@ robustness details (Ctrl-C in sweeps, dopri5 on a stiff scene)."""
 
 from __future__ import annotations
 
+import json
 import os
 import pickle
+import re
 import signal
 import subprocess
 import sys
@@ -50,6 +52,28 @@ def test_unknown_fields_are_rejected_everywhere(changes: dict[str, object]) -> N
     data["joints"] = {"kind": "rigid", "stiffness": 1e9}
     with pytest.raises(rvdyn.SceneError, match="unknown"):
         Scene(data)
+
+
+@pytest.mark.parametrize(("path", "value", "says"), [
+    ("joints.eccentric_bearing.rollers.count", 3.5, "joints.eccentric_bearing.rollers.count must be an integer, got 3.5"),
+    ("load.torque", "4e4", 'load.torque must be a number [N m], got "4e4"'),
+    ("contact.pin.damping.ratio", [0.1], "contact.pin.damping.ratio must be a number, got [0.1]"),
+    ("discs", [{"phase": "pi"}, {"phase": 0.0}], 'discs[0].phase must be a number [rad], got "pi"'),
+    ("crank_layout", {"bearings": [0.0, 0.1], "discs": [0.0, 0.0], "planet": None},
+     "crank_layout.planet must be a number [m], got null"),
+])
+def test_a_value_of_the_wrong_type_is_named_by_its_path(path: str, value: object, says: str) -> None:
+    # Inside the tagged objects (joints, load, contact laws) too, through replace and from a file.
+    with pytest.raises(rvdyn.SceneError, match=re.escape(says)):
+        Scene.physical("rated").replace(**{path: value})
+    data = Scene.physical("rated").to_dict()
+    node = data
+    *parents, last = path.split(".")
+    for key in parents:
+        node = node[key]
+    node[last] = value
+    with pytest.raises(rvdyn.SceneError, match=re.escape(says)):
+        Scene.from_json(json.dumps(data))
 
 
 def test_equal_scenes_hash_equal() -> None:

@@ -948,8 +948,13 @@ impl Scene {
     /// naming its path, in internally tagged enums too (where serde's `deny_unknown_fields`
     /// does not reach).
     pub fn from_value(v: &serde_json::Value) -> Result<Self> {
-        // The path of the value serde could not read, not only what was wrong with it.
+        // The path of the value serde could not read, not only what was wrong with it: from
+        // the schema table where a value has the wrong type, else from serde's path (which
+        // stops at an internally tagged object).
         let s: Scene = serde_path_to_error::deserialize(v.clone()).map_err(|e| {
+            if let Some(m) = schema::mistyped(v) {
+                return RvdynError::Scene(format!("invalid scene: {m}"));
+            }
             let path = e.path().to_string();
             let at = if path == "." {
                 String::new()

@@ -1324,6 +1324,95 @@ pub static FIELDS: &[Field] = &[
     ),
 ];
 
+/// Whether the JSON value `v` is of the table's type `ty` (a type the check does not know
+/// passes: serde then has the last word).
+fn has_type(v: &serde_json::Value, ty: &str) -> bool {
+    use serde_json::Value;
+    if let Some(base) = ty.strip_suffix(" or null") {
+        return v.is_null() || has_type(v, base);
+    }
+    let numbers = |v: &Value, n: Option<usize>| {
+        v.as_array()
+            .is_some_and(|a| n.is_none_or(|n| a.len() == n) && a.iter().all(Value::is_number))
+    };
+    match ty {
+        "number" => v.is_number(),
+        "integer" => v.is_u64() || v.is_i64(),
+        "string" => v.is_string(),
+        "object" => v.is_object(),
+        "list of objects" => v.as_array().is_some_and(|a| a.iter().all(Value::is_object)),
+        "list of numbers" => numbers(v, None),
+        "list of 2 numbers" => numbers(v, Some(2)),
+        t if t.starts_with("list of [") => {
+            let n = t.matches(',').count() + 1;
+            v.as_array()
+                .is_some_and(|a| a.iter().all(|p| numbers(p, Some(n))))
+        }
+        _ => true,
+    }
+}
+
+/// `ty` after "a" or "an" ("an integer", "a list of numbers").
+fn with_article(ty: &str) -> String {
+    let an = ty.starts_with(['a', 'e', 'i', 'o', 'u']);
+    format!("{} {ty}", if an { "an" } else { "a" })
+}
+
+/// The first field of the scene tree `tree` whose value is not of the type the table gives
+/// it, as a message naming its path, the type and unit expected and the value found; `None`
+/// if every listed field has its type. serde's own message names no path inside an
+/// internally tagged object (`joints`, `load`, the contact laws), this one does.
+pub fn mistyped(tree: &serde_json::Value) -> Option<String> {
+    use serde_json::Value;
+    fn walk(v: &Value, at: &str, table: &str) -> Option<String> {
+        let Value::Object(m) = v else { return None };
+        for (k, child) in m {
+            let (at, table) = if at.is_empty() {
+                (k.clone(), k.clone())
+            } else {
+                (format!("{at}.{k}"), format!("{table}.{k}"))
+            };
+            let table = match table.strip_prefix("contact.") {
+                Some(rest) if at.split('.').count() > 2 => {
+                    format!("contact.*.{}", rest.split_once('.').map_or("", |p| p.1))
+                }
+                _ => table,
+            };
+            let rows: Vec<&Field> = FIELDS.iter().filter(|f| f.path == table).collect();
+            if let Some(row) = rows.first()
+                && !rows.iter().any(|f| has_type(child, f.ty))
+            {
+                let unit = if row.unit == "-" {
+                    String::new()
+                } else {
+                    format!(" [{}]", row.unit)
+                };
+                let mut got = child.to_string();
+                if got.chars().count() > 60 {
+                    got = format!("{}...", got.chars().take(57).collect::<String>());
+                }
+                return Some(format!(
+                    "{at} must be {}{unit}, got {got}",
+                    with_article(row.ty)
+                ));
+            }
+            let found = match child {
+                Value::Object(_) => walk(child, &at, &table),
+                Value::Array(items) => items
+                    .iter()
+                    .enumerate()
+                    .find_map(|(i, item)| walk(item, &format!("{at}[{i}]"), &format!("{table}[]"))),
+                _ => None,
+            };
+            if found.is_some() {
+                return found;
+            }
+        }
+        None
+    }
+    walk(tree, "", "")
+}
+
 /// The table as the Markdown of `docs/scene.md`.
 pub fn markdown() -> String {
     let mut s = String::from(
@@ -1556,6 +1645,59 @@ mod tests {
                         checked += 1;
                     }
                 }
+            }
+        }
+        assert!(checked >= FIELDS.len(), "only {checked} checks");
+    }
+
+    /// Every field of the example scenes has its table type, and a value of another type at
+    /// any field makes the scene an error naming that field's path (inside tagged objects too,
+    /// where serde's own message stops at the object).
+    #[test]
+    fn a_mistyped_field_is_named_by_its_path() {
+        let mut checked = 0;
+        for example in examples() {
+            assert_eq!(mistyped(&example), None);
+            for x in FIELDS {
+                let concrete = x
+                    .path
+                    .replace("contact.*", "contact.pin")
+                    .replace("[]", ".0");
+                let mut tree = example.clone();
+                let Ok(node) = crate::dynamics::scene::get_path(&tree, &concrete) else {
+                    continue;
+                };
+                if !x.when.is_empty() && node.is_null() {
+                    continue;
+                }
+                let wrong = if x.ty.contains("string") {
+                    json!(1.5)
+                } else {
+                    json!("x")
+                };
+                let named = concrete.replace(".0.", "[0].").replace(".0", "[0]");
+                let (parent, key) = concrete.rsplit_once('.').unwrap_or(("", &concrete));
+                let holder = if parent.is_empty() {
+                    &mut tree
+                } else {
+                    let mut node = &mut tree;
+                    for k in parent.split('.') {
+                        node = match node {
+                            Value::Array(a) => &mut a[k.parse::<usize>().unwrap()],
+                            other => &mut other[k],
+                        };
+                    }
+                    node
+                };
+                holder[key] = wrong;
+                let err = Scene::from_value(&tree).unwrap_err().to_string();
+                assert!(
+                    err.contains(&format!("{named} must be {}", with_article(x.ty)))
+                        || err.contains(&format!("invalid scene: {named}: ")),
+                    "{}: {err}",
+                    x.path
+                );
+                checked += 1;
             }
         }
         assert!(checked >= FIELDS.len(), "only {checked} checks");
