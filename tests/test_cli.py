@@ -64,6 +64,17 @@ def test_info_text():
     for fragment in ("ratio i", "= 57", "146.105 deg/s", "770.55 N m", "43.92 kN m",
                      "INCONSISTENT", "10.3 kW", "K1 = 0.7200", "convex-concave"):
         assert fragment in r.stdout, fragment
+    # The presets' table: each column starts where its heading does, one blank column at
+    # least before it (an entry longer than its column used to run into the next).
+    lines = r.stdout.splitlines()
+    top = lines.index("Presets side by side (rated load)")
+    head = lines[top + 1]
+    cols = [head.index("paper"), head.index("physical")]
+    body = lines[top + 2:top + 8]
+    assert body[0].strip().startswith("pin contact law") and body[-1].strip().startswith("main torsional mode")
+    for line in body:
+        for c in cols:
+            assert line[c - 2:c] == "  " and line[c] != " ", (line, c)
 
 
 @pytest.mark.parametrize("command, name", [("plot-geometry", "geometry.png"),

@@ -205,7 +205,7 @@ def _format_presets(p: dict[str, Any]) -> list[str]:
     a, b = p["paper"], p["physical"]
     rows = [
         ("pin contact law", a["pin_law"], b["pin_law"]),
-        ("pin approach at the reference pin force (4 T_c/(zp rc'), T_c = T_out/2)",
+        ("pin approach at the reference pin force (*)",
          f"{a['pin_approach_m'] * 1e6:.1f} um at {a['peak_pin_force_N'] / 1e3:.1f} kN",
          f"{b['pin_approach_m'] * 1e6:.1f} um at {b['peak_pin_force_N'] / 1e3:.1f} kN"),
         ("mesh law", a["mesh_law"], b["mesh_law"]),
@@ -214,8 +214,12 @@ def _format_presets(p: dict[str, Any]) -> list[str]:
         ("pin damping", a["damping"], b["damping"]),
         ("main torsional mode", a["main_torsional_mode"], b["main_torsional_mode"]),
     ]
-    lines = ["Presets side by side (rated load)", f"  {'':42s} {'paper':34s} physical"]
-    lines += [f"  {name:42s} {x:34s} {y}" for name, x, y in rows]
+    # Columns as wide as their longest entry, so that no entry runs into the next.
+    w0, w1 = (max(len(r[k]) for r in rows) for k in (0, 1))
+    lines = ["Presets side by side (rated load)", f"  {'':{w0}s}  {'paper':{w1}s}  physical"]
+    lines += [f"  {name:{w0}s}  {x:{w1}s}  {y}" for name, x, y in rows]
+    lines.append("  (*) 4 T_c / (zp rc') with T_c = T_out / 2: the largest pin force of the classical load sharing "
+                 "(rigid pins, linear law; Malhotra & Parameswaran 1983)")
     lines.append(f"  ({p['note']})")
     return lines
 
