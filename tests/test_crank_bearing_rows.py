@@ -116,6 +116,7 @@ def test_bad_layouts_and_inputs_are_refused() -> None:
         # The hypothesis suite found an int beyond the floats raising OverflowError here.
         ({"bearings": (0.0, 0.1), "discs": (0.0,), "planet": 0.0, "roller_length": 10**400}, "roller_length"),
         ({"bearings": (0.0, 0.1), "discs": (0.0,), "planet": 0.0, "roller_length": True}, "roller_length"),
+        ({"bearings": (0.0, 0.1), "discs": (0.0,), "planet": 0.0, "roller_length": 20.0}, r"\(0, 1\] m .* in mm"),
     ):
         with pytest.raises(ParameterError, match=match):
             CrankLayout(**kwargs)  # type: ignore[arg-type]

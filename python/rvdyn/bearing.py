@@ -39,7 +39,7 @@ class CrankLayout:
         Mid-plane of the planet, where the mesh force acts (a dynamic run's crank inertia force
         is put there too: exact in the quasi-static LTCA; docs/model.md gives the error).
     roller_length : float or None
-        Roller length of each of the two bearings [m], for their ISO 76/281 ratings; None: half
+        Roller length of each of the two bearings [m], in (0, 1], for their ISO 76/281 ratings; None: half
         the scene's lumped crank roller length (the lumped row stands for two equal bearings).
 
     Examples
@@ -70,8 +70,9 @@ class CrankLayout:
                 value = float(length) if isinstance(length, (int, float)) and not isinstance(length, bool) else math.nan
             except OverflowError:  # an int beyond the floats
                 value = math.nan
-            if not (math.isfinite(value) and value > 0):
-                raise ParameterError(f"CrankLayout.roller_length must be a positive length [m] or None, got {length!r}")
+            if not (math.isfinite(value) and 0 < value <= 1.0):  # the scene's bound on roller lengths
+                raise ParameterError(f"CrankLayout.roller_length must be a length in (0, 1] m or None, got {length!r} "
+                                     "(a value in mm? 20 mm is 0.02 m)")
             object.__setattr__(self, "roller_length", value)
         object.__setattr__(self, "bearings", bearings)
         object.__setattr__(self, "discs", discs)
