@@ -13,8 +13,8 @@ atol 1e-13 m, rtol 1e-9, and the settings of BENCHMARKS.md section 11. ``--t-end
 the run (the error window stays [0.5, t_end] s), ``--repeat`` sets the runs per setting (the
 smallest wall and CPU time are reported), ``--only TEXT`` runs the settings whose label contains
 TEXT, ``--ref-cache FILE.npz`` keeps the two references between invocations, ``--dt S ...``
-replaces the paper preset's fixed steps (results then go to ``speed_goal_paper_*_steps.json``). CPU time is the process's (the run holds one worker
-thread; the caller only waits).
+replaces the paper preset's fixed steps (results then go to ``speed_goal_paper_*_steps.json``).
+CPU time is the process's (the run holds one worker thread; the caller only waits).
 """
 
 from __future__ import annotations
