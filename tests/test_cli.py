@@ -177,6 +177,8 @@ def test_analyze_gives_the_bearings_static_safety_and_the_crank_layout(tmp_path)
         assert s[name]["static_safety"] == pytest.approx(want[name]["static_safety"], rel=1e-9)
     assert "rvdyn analyze: warning: bearing_safety: the crank_a bearings' peak load" in r.stderr
     assert "crank a peak" in (tmp_path / "rows" / "summary.md").read_text()
+    assert str(tmp_path / "rows" / "bearing_loads.png") in json.loads((tmp_path / "rows" / "summary.json").read_text())["files"]
+    assert (tmp_path / "rows" / "bearing_loads.png").stat().st_size > 0
     # Too few positions, or a scene without roller crank bearings: refused before the work.
     r = run("analyze", "--crank-layout", "0", "1", "2", "--out", str(tmp_path / "few"))
     assert r.returncode == 1 and "at least 4 positions" in r.stderr and not (tmp_path / "few").exists()

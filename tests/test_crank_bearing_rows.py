@@ -239,3 +239,29 @@ def test_a_scene_layout_without_roller_crank_bearings_is_kept_but_not_rated() ->
 def test_a_bad_scene_layout_is_a_scene_error_naming_the_field(layout: dict[str, object], match: str) -> None:
     with pytest.raises(rvdyn.SceneError, match=match):
         Scene.physical("rated").replace(crank_layout=layout)
+
+
+def test_bearing_load_plot_draws_each_familys_worst_bearing_and_its_rating(
+        quasi_static: rvdyn.analysis.LtcaResult) -> None:
+    # Per crank angle the largest load of the family's bearings (all cranks, and discs for the
+    # eccentric ones), and C0r as a constant line: bearing_safety's peak and rating.
+    safety = quasi_static.bearing_safety()
+    lines = {line.get_label(): line for line in quasi_static.plot_bearing_loads().axes[0].get_lines()}
+    assert sorted(lines) == ["crank", "crank C0r", "eccentric", "eccentric C0r"]
+    for name, force in (("crank", quasi_static.crank_bearing_force),
+                        ("eccentric", quasi_static.eccentric_bearing_force)):
+        x, y = (np.asarray(v, dtype=float) for v in lines[name].get_data())
+        np.testing.assert_allclose(x, np.degrees(quasi_static.crank_angle), rtol=0, atol=0)
+        want = np.linalg.norm(force, axis=-1).reshape(len(x), -1).max(axis=1) / 1e3
+        np.testing.assert_allclose(y, want, rtol=1e-15)
+        assert y.max() == pytest.approx(safety[name]["peak_load"] / 1e3, rel=1e-15)
+        assert lines[f"{name} C0r"].get_ydata()[0] == pytest.approx(safety[name]["static_rating"] / 1e3, rel=1e-15)
+    # With a layout: the crank's two bearings, each against the rating of its shorter rollers.
+    layout = CrankLayout(bearings=(-0.05, 0.05), discs=(0.0, 0.0), planet=0.0)
+    mid = quasi_static.bearing_safety(layout)
+    lines = {line.get_label(): line for line in quasi_static.plot_bearing_loads(layout).axes[0].get_lines()}
+    assert sorted(lines) == ["crank_a", "crank_a, crank_b C0r", "crank_b", "eccentric", "eccentric C0r"]
+    assert lines["crank_a, crank_b C0r"].get_ydata()[0] == pytest.approx(mid["crank_b"]["static_rating"] / 1e3)
+    assert max(lines["crank_a"].get_ydata()) == pytest.approx(mid["crank_a"]["peak_load"] / 1e3, rel=1e-14)
+    with pytest.raises(ParameterError, match="joints are rigid"):
+        rvdyn.ltca(Scene.paper("rated"), crank_angles=[0.0]).plot_bearing_loads()

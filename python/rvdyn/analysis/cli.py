@@ -103,6 +103,8 @@ def run(args: argparse.Namespace) -> int:
     # Static safety at this torque where the bearings are built from rollers (ISO 76).
     rated = res.crank_bearing_force.size and any(c is not None for c in scene._compiled.bearing_ratings("static"))
     bearings = res.bearing_safety(layout) if rated else {}
+    if bearings:
+        files.append(save_figure(res.plot_bearing_loads(layout), str(out / "bearing_loads.png")))
     pp = te.peak_to_peak()
     harmonics = te.harmonics("forward", 3)
     summary = {

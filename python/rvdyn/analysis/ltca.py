@@ -149,6 +149,23 @@ class LtcaResult:
         """
         from ..bearing import static_safety
 
+        families = self._bearing_families(crank_layout)
+        out: dict[str, dict[str, float]] = {}
+        for name, static, forces in families:
+            if static is None:
+                continue
+            mag = np.linalg.norm(forces, axis=-1)
+            at = np.unravel_index(int(np.argmax(mag)), mag.shape)
+            peak = float(mag[at])
+            s0 = static_safety("bearing_safety", name, peak, static,
+                               "use larger bearings (joints.*.rollers) or a lower torque")
+            out[name] = {"peak_load": peak, "crank_angle": float(self.arrays["crank_angle"][at[0]]),
+                         "static_rating": float(static), "static_safety": s0}
+        return out
+
+    def _bearing_families(self, crank_layout: CrankLayout | None) -> list[tuple[str, float | None, np.ndarray]]:
+        """Each bearing family's name, ISO 76 static rating ``C0r`` [N] (None without rollers)
+        and forces (n, ..., 2) [N], as :meth:`bearing_safety` describes them; its refusals."""
         if self.scene is None:
             raise ParameterError("this LtcaResult carries no scene, so no bearing rating: take it from rvdyn.ltca")
         crank_force = self.arrays["crank_bearing_force"]
@@ -174,18 +191,40 @@ class LtcaResult:
             s_row = row.bearing_ratings("static")[1]
             rows = crank_layout.rows(crank_force, ecc_force)
             families += [(f"crank_{side}", s_row, rows[:, :, j]) for j, side in enumerate("ab")]
-        out: dict[str, dict[str, float]] = {}
-        for name, static, forces in families:
-            if static is None:
-                continue
-            mag = np.linalg.norm(forces, axis=-1)
-            at = np.unravel_index(int(np.argmax(mag)), mag.shape)
-            peak = float(mag[at])
-            s0 = static_safety("bearing_safety", name, peak, static,
-                               "use larger bearings (joints.*.rollers) or a lower torque")
-            out[name] = {"peak_load": peak, "crank_angle": float(self.arrays["crank_angle"][at[0]]),
-                         "static_rating": float(static), "static_safety": s0}
-        return out
+        return families
+
+    def plot_bearing_loads(self, crank_layout: CrankLayout | None = None, ax: Axes | None = None) -> Figure:
+        """The load [kN] of the most loaded bearing of each family (:meth:`bearing_safety`'s
+        families and ``crank_layout``) at each crank angle, with the family's ISO 76 static
+        rating ``C0r`` as a dashed line of the same colour (black for a rating shared by several
+        families, as the crank's two rows): where a curve crosses its line, the static safety
+        ``s0`` is below 1. Same refusals as :meth:`bearing_safety`.
+
+        >>> import rvdyn
+        >>> lt = rvdyn.ltca(rvdyn.Scene.physical("rated"), crank_angles=[0.0, 0.05, 0.1])
+        >>> fig = lt.plot_bearing_loads()
+        >>> [line.get_label() for line in fig.axes[0].get_lines()]
+        ['eccentric', 'crank', 'eccentric C0r', 'crank C0r']
+        """
+        from ..plotting import new_figure
+
+        families = [f for f in self._bearing_families(crank_layout) if f[1] is not None]
+        fig, ax = new_figure((8.0, 4.5)) if ax is None else (ax.figure, ax)
+        angle = np.degrees(self.arrays["crank_angle"])
+        ratings: dict[float, list[int]] = {}  # one line per rating (the crank's two rows share theirs)
+        for k, (name, static, forces) in enumerate(families):
+            mag = np.linalg.norm(forces, axis=-1).reshape(len(angle), -1).max(axis=1)
+            ax.plot(angle, mag / 1e3, marker="." if len(angle) < 50 else None, color=f"C{k}", label=name)
+            ratings.setdefault(float(static), []).append(k)  # type: ignore[arg-type]
+        for static, ks in ratings.items():
+            ax.axhline(static / 1e3, color=f"C{ks[0]}" if len(ks) == 1 else "k", ls="--", lw=0.8,
+                       label=", ".join(families[k][0] for k in ks) + " C0r")
+        ax.set_ylim(bottom=0.0)  # loads against ratings from zero: the margin is seen in proportion
+        ax.set_xlabel("crank angle [deg]")
+        ax.set_ylabel("load of the most loaded bearing [kN]")
+        ax.set_title(f"bearing loads and ISO 76 static ratings, T = {self.torque / 1e3:.2f} kN m")
+        ax.legend(fontsize="small")
+        return fig  # type: ignore[return-value]
 
     def worst_index(self, disc: int = 0) -> int:
         """Index of the crank angle with the largest pin force on ``disc``."""
