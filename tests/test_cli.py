@@ -177,6 +177,13 @@ def test_analyze_gives_the_bearings_static_safety_and_the_crank_layout(tmp_path)
         assert s[name]["static_safety"] == pytest.approx(want[name]["static_safety"], rel=1e-9)
     assert "rvdyn analyze: warning: bearing_safety: the crank_a bearings' peak load" in r.stderr
     assert "crank a peak" in (tmp_path / "rows" / "summary.md").read_text()
+    lives = json.loads((tmp_path / "rows" / "summary.json").read_text())["bearing_life"]
+    with pytest.warns(RuntimeWarning, match="crank_a"):
+        want_life = rvdyn.ltca(scene, crank_angles=angles).bearing_life(crank_layout=layout)
+    assert sorted(lives) == ["crank_a", "crank_b", "crank_pair", "eccentric"]
+    for name in lives:
+        assert lives[name]["l10_hours"] == pytest.approx(want_life[name]["l10_hours"], rel=1e-9)
+    assert "crank pair" in (tmp_path / "rows" / "summary.md").read_text()
     assert str(tmp_path / "rows" / "bearing_loads.png") in json.loads((tmp_path / "rows" / "summary.json").read_text())["files"]
     assert (tmp_path / "rows" / "bearing_loads.png").stat().st_size > 0
     # Too few positions, or a scene without roller crank bearings: refused before the work.

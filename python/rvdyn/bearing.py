@@ -134,3 +134,49 @@ def static_safety(caller: str, family: str, peak: float, static: float, remedy: 
             f"rating C0r = {static / 1e3:.1f} kN (static safety s0 = {s0:.2f} < 1): the raceways yield there "
             f"and the elastic roller law and the forces do not hold; {remedy}", RuntimeWarning, stacklevel=3)
     return s0
+
+
+#: One bearing family to rate (:func:`rate_lives`): name, ISO 281 rating ``C`` [N] and ISO 76
+#: static rating ``C0r`` [N] (None without rollers), peak load [N], and per interval the load
+#: [N] and the revolutions of the rings [-], shape (intervals, bearings...).
+Family = tuple[str, "float | None", "float | None", float, NDArray[np.float64], NDArray[np.float64]]
+
+
+def rate_lives(caller: str, families: list[Family], duration: float) -> dict[str, dict[str, float]]:
+    """ISO 281 equivalent load and ``L10`` of the most loaded bearing (largest equivalent load)
+    of each family, with the ISO 76 static safety of its peak (:func:`static_safety`), over a
+    duty cycle of ``duration`` [s] (the hours); and, where the families hold a crank's two
+    rows ``crank_a`` and ``crank_b``, ``crank_pair``: the worst crank's system life
+    (Lundberg-Palmgren) and the smaller ``s0``. Families without ratings are left out. The
+    entries are those :meth:`rvdyn.Result.bearing_life` documents."""
+    out: dict[str, dict[str, float]] = {}
+    crank_lives: dict[str, tuple[dict[tuple[int, ...], tuple[float, float]], NDArray[np.float64]]] = {}
+    for name, rating, static, peak, load, rev in families:
+        if rating is None or static is None:
+            continue
+        total = rev.sum(axis=0)
+        # ISO 281 per bearing in the core: (equivalent load, L10); the worst is the largest load.
+        lives = {j: _core.roller_bearing_life(rating, load[(slice(None),) + j].tolist(),
+                                              rev[(slice(None),) + j].tolist())
+                 for j in np.ndindex(*load.shape[1:])}
+        crank_lives[name] = (lives, total)
+        worst = max(lives, key=lambda j: lives[j][0])
+        p, l10 = lives[worst]
+        rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
+        s0 = static_safety(caller, name, peak, static,
+                           "nor does the rating life; use larger bearings (joints.*.rollers) or a lower load")
+        out[name] = {"peak_load": peak, "equivalent_load": p, "rating": float(rating),
+                     "static_rating": float(static), "static_safety": s0,
+                     "l10_million_revolutions": l10,
+                     "l10_hours": l10 * 1e6 / (60.0 * rpm) if rpm > 0 else math.inf}
+    if "crank_a" in crank_lives and "crank_b" in crank_lives:
+        # A crank's two bearings fail as a system (Lundberg-Palmgren); the worst crank counts.
+        (lives_a, total), (lives_b, _) = crank_lives["crank_a"], crank_lives["crank_b"]
+        pair = {j: _core.roller_system_life([lives_a[j][1], lives_b[j][1]]) for j in lives_a}
+        worst = min(pair, key=lambda j: pair[j])
+        rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
+        out["crank_pair"] = {
+            "static_safety": min(out["crank_a"]["static_safety"], out["crank_b"]["static_safety"]),
+            "l10_million_revolutions": pair[worst],
+            "l10_hours": pair[worst] * 1e6 / (60.0 * rpm) if rpm > 0 else math.inf}
+    return out

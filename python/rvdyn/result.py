@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from . import _core
 from .errors import ParameterError, RvdynError
 from ._args import read_only
-from .bearing import static_safety
+from .bearing import Family, rate_lives
 from ._args import real as _real
 from ._args import whole as _whole
 from .plotting import pin_indices
@@ -377,7 +377,6 @@ class Result:
                 "(steady_window): run longer for a life that does not depend on the window",
                 RuntimeWarning, stacklevel=2)
         duration = float(t[-1] - t[0])
-        out: dict[str, dict[str, float]] = {}
         crank = self.crank_angle[i0:]
         crank_rel = crank - self.carrier_angle[i0:][:, None]
         families: list[tuple[str, float | None, float | None, NDArray[np.float64], NDArray[np.float64]]] = [
@@ -394,41 +393,13 @@ class Result:
             c_row, s_row = row.bearing_ratings()[1], row.bearing_ratings("static")[1]
             rows = crank_layout.rows(self.crank_bearing_force[i0:], self.eccentric_bearing_force[i0:])
             families += [(f"crank_{side}", c_row, s_row, rows[:, :, j], crank_rel) for j, side in enumerate("ab")]
-        # Per crank row: the (equivalent load, L10) of each crank and its revolutions.
-        crank_lives: dict[str, tuple[dict[tuple[int, ...], tuple[float, float]], NDArray[np.float64]]] = {}
-        for name, rating, static, forces, rel in families:
-            if rating is None or static is None:
-                continue
-            mag = np.linalg.norm(forces, axis=-1)
-            rev = np.abs(np.diff(rel, axis=0)) / (2 * np.pi)
-            load = 0.5 * (mag[1:] + mag[:-1])
-            total = rev.sum(axis=0)
-            # ISO 281 per bearing in the core: (equivalent load, L10); the worst is the largest load.
-            lives = {j: _core.roller_bearing_life(rating, load[(slice(None),) + j].tolist(),
-                                                  rev[(slice(None),) + j].tolist())
-                     for j in np.ndindex(*load.shape[1:])}
-            crank_lives[name] = (lives, total)
-            worst = max(lives, key=lambda j: lives[j][0])
-            p, l10 = lives[worst]
-            rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
-            peak = float(mag.max())
-            s0 = static_safety("bearing_life", name, peak, static,
-                               "nor does the rating life; use larger bearings (joints.*.rollers) or a lower load")
-            out[name] = {"peak_load": peak, "equivalent_load": p, "rating": float(rating),
-                         "static_rating": float(static), "static_safety": s0,
-                         "l10_million_revolutions": l10,
-                         "l10_hours": l10 * 1e6 / (60.0 * rpm) if rpm > 0 else math.inf}
-        if "crank_a" in crank_lives:
-            # A crank's two bearings fail as a system (Lundberg-Palmgren); the worst crank counts.
-            (lives_a, total), (lives_b, _) = crank_lives["crank_a"], crank_lives["crank_b"]
-            pair = {j: _core.roller_system_life([lives_a[j][1], lives_b[j][1]]) for j in lives_a}
-            worst = min(pair, key=lambda j: pair[j])
-            rpm = float(total[worst]) / duration * 60.0 if duration > 0 else 0.0
-            out["crank_pair"] = {
-                "static_safety": min(out["crank_a"]["static_safety"], out["crank_b"]["static_safety"]),
-                "l10_million_revolutions": pair[worst],
-                "l10_hours": pair[worst] * 1e6 / (60.0 * rpm) if rpm > 0 else math.inf}
-        return out
+        # Per interval between samples: the mean load and the rings' revolutions.
+        rated: list[Family] = [
+            (name, rating, static, float(np.linalg.norm(forces, axis=-1).max()),
+             0.5 * (np.linalg.norm(forces[1:], axis=-1) + np.linalg.norm(forces[:-1], axis=-1)),
+             np.abs(np.diff(rel, axis=0)) / (2 * np.pi))
+            for name, rating, static, forces, rel in families]
+        return rate_lives("bearing_life", rated, duration)
 
     # -------------------------------------------------------------------- files
     def save(self, path: str | Path) -> Path:

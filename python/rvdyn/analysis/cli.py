@@ -105,6 +105,15 @@ def run(args: argparse.Namespace) -> int:
     bearings = res.bearing_safety(layout) if rated else {}
     if bearings:
         files.append(save_figure(res.plot_bearing_loads(layout), str(out / "bearing_loads.png")))
+    # ISO 281 life for steady running at the scene's drive speed (the LTCA's angles span the period).
+    # (Its s0 warning would repeat bearing_safety's; the summary marks those lives instead.)
+    lives = {}
+    if bearings and scene["drive.kind"] == "speed":
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            lives = res.bearing_life(crank_layout=layout)
     pp = te.peak_to_peak()
     harmonics = te.harmonics("forward", 3)
     summary = {
@@ -128,6 +137,7 @@ def run(args: argparse.Namespace) -> int:
                            "reverse": float(te.reverse.mean()) / ARCMIN},
         **loop.summary(),
         "bearing_static_safety": bearings,
+        "bearing_life": lives,
         # The layout that split the crank bearing into crank_a and crank_b [m], if any.
         "crank_layout": dataclasses.asdict(layout) if layout is not None and bearings else None,
         "files": [*files, str(csv_path), str(json_path)],
@@ -163,6 +173,10 @@ def run(args: argparse.Namespace) -> int:
                + ", each with rollers of "
                + ("half the lumped length" if layout.roller_length is None else f"{layout.roller_length * 1e3:g} mm")
                + ")" if layout is not None else ""))] if bearings else []),
+        *([f"- rating life (ISO 281 L10, steady running at {scene['drive.speed']:.4g} rad/s input and this torque): "
+           + "; ".join(f"{name.replace('_', ' ')} {b['l10_hours']:.4g} h"
+                       + (" (s0 < 1: not valid)" if b["static_safety"] < 1 else "") for name, b in lives.items())]
+          if lives else []),
         f"- equilibrium: torque balance <= {summary['torque_balance_max']:.1e}, residual <= "
         f"{summary['residual_max']:.1e} (relative)",
         *([f"- friction (pins {fr['pin']:g}, teeth {fr['mesh']:g}"

@@ -151,7 +151,7 @@ class LtcaResult:
 
         families = self._bearing_families(crank_layout)
         out: dict[str, dict[str, float]] = {}
-        for name, static, forces in families:
+        for name, _, static, forces in families:
             if static is None:
                 continue
             mag = np.linalg.norm(forces, axis=-1)
@@ -163,9 +163,67 @@ class LtcaResult:
                          "static_rating": float(static), "static_safety": s0}
         return out
 
-    def _bearing_families(self, crank_layout: CrankLayout | None) -> list[tuple[str, float | None, np.ndarray]]:
-        """Each bearing family's name, ISO 76 static rating ``C0r`` [N] (None without rollers)
-        and forces (n, ..., 2) [N], as :meth:`bearing_safety` describes them; its refusals."""
+    def bearing_life(self, speed: float | None = None,
+                     crank_layout: CrankLayout | None = None) -> dict[str, dict[str, float]]:
+        """ISO 281 rating life of the bearings at this torque, from the quasi-static loads over
+        the crank angles: the same entries as :meth:`rvdyn.Result.bearing_life` (peak and
+        equivalent load, ratings, static safety, ``L10`` in million revolutions and hours, and
+        with a crank layout ``crank_a``, ``crank_b`` and ``crank_pair``), for steady running at
+        the input ``speed`` [rad/s] (default: the scene's constant drive speed).
+
+        Each crank angle stands for an equal share of the rings' revolutions (the rings turn
+        relative to each other by ``zp/zc`` of the crank angle, docs/model.md "Crank bearing
+        rows"), so the crank angles must be equally spaced over whole mesh periods (the
+        default grid of :func:`rvdyn.ltca`): ``ParameterError`` otherwise. With roller
+        bearings the periods differ a little (the roller sets stay in the frame); more periods
+        give the exact cycle. Inertia is left out (a run includes it); the refusals of
+        :meth:`bearing_safety` apply.
+
+        >>> import rvdyn
+        >>> life = rvdyn.ltca(rvdyn.Scene.physical("rated")).bearing_life()  # 90 angles over the period
+        >>> sorted(life), round(life["eccentric"]["l10_hours"], 1)  # at 8328 deg/s and 43.9 kN m
+        (['crank', 'eccentric'], 18.6)
+        """
+        from ..bearing import Family, rate_lives
+
+        psi = np.asarray(self.arrays["crank_angle"], dtype=float)
+        n = psi.size
+        step = (psi[-1] - psi[0]) / (n - 1) if n > 1 else 0.0
+        periods = n * step / self.mesh_period if step > 0 else 0.0
+        if (n < 2 or not np.allclose(np.diff(psi), step, rtol=1e-9, atol=0.0)
+                or abs(periods - round(periods)) > 1e-6 or round(periods) < 1):
+            raise ParameterError(
+                f"bearing_life needs crank angles equally spaced over whole mesh periods ({self.mesh_period:.6g} "
+                f"rad each), as rvdyn.ltca(scene, torque, crank_angles=N) gives; got {n} angle(s) covering "
+                f"{periods:.4g} period(s)")
+        if speed is None:
+            drive = (self.scene or {}).get("drive", {})
+            if drive.get("kind") != "speed":
+                raise ParameterError("the scene is not driven at a constant speed: give speed [rad/s]")
+            speed = float(drive["speed"])
+        try:
+            omega = abs(float(speed))
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"speed must be the input speed in rad/s, got {speed!r}") from exc
+        if not (math.isfinite(omega) and omega > 0):
+            raise ParameterError(f"speed must be a finite, non-zero input speed [rad/s], got {speed!r}")
+        zp = int((self.scene or {})["cycloid"]["pins"])
+        ring_turn = float(step) * zp / (zp - 1) / (2 * math.pi)  # ring revolutions per crank angle step
+        # The input turns with the crank angle as the held input's kinematics say.
+        inputs = np.asarray(self.arrays["input_angle"], dtype=float)
+        input_per_psi = abs(float(inputs[-1] - inputs[0])) / float(psi[-1] - psi[0])
+        duration = float(n * step * input_per_psi / omega)  # [s] for the cycle at this speed
+        rated: list[Family] = []
+        for name, rating, static, forces in self._bearing_families(crank_layout):
+            mag = np.linalg.norm(forces, axis=-1)
+            rated.append((name, rating, static, float(mag.max()), mag, np.full(mag.shape, ring_turn)))
+        return rate_lives("bearing_life", rated, duration)
+
+    def _bearing_families(
+            self, crank_layout: CrankLayout | None) -> list[tuple[str, float | None, float | None, np.ndarray]]:
+        """Each bearing family's name, ISO 281 rating ``C`` and ISO 76 static rating ``C0r`` [N]
+        (None without rollers) and forces (n, ..., 2) [N], as :meth:`bearing_safety` describes
+        them; its refusals."""
         if self.scene is None:
             raise ParameterError("this LtcaResult carries no scene, so no bearing rating: take it from rvdyn.ltca")
         crank_force = self.arrays["crank_bearing_force"]
@@ -173,24 +231,25 @@ class LtcaResult:
         if crank_force.size == 0:
             raise ParameterError("the scene's joints are rigid, so the LTCA has no bearing forces: give "
                                  "compliant joints with rollers (joints.*.rollers), as Scene.physical has")
-        s_ecc, s_crank = _core.CompiledScene.from_json(json.dumps(self.scene)).bearing_ratings("static")
+        compiled = _core.CompiledScene.from_json(json.dumps(self.scene))
+        (c_ecc, c_crank), (s_ecc, s_crank) = compiled.bearing_ratings(), compiled.bearing_ratings("static")
         if s_ecc is None and s_crank is None:
             raise ParameterError(
                 "no bearing of this scene is built from rollers, so there is no ISO 76 static rating: give "
                 "joints.eccentric_bearing.rollers (and joints.crank_bearing.rollers), as Scene.physical "
                 "does; the bearing forces are in eccentric_bearing_force and crank_bearing_force")
-        families: list[tuple[str, float | None, np.ndarray]] = [("eccentric", s_ecc, ecc_force)]
+        families: list[tuple[str, float | None, float | None, np.ndarray]] = [("eccentric", c_ecc, s_ecc, ecc_force)]
         if crank_layout is None:
             from ..bearing import CrankLayout
 
             crank_layout = CrankLayout.of_scene(self.scene)
         if crank_layout is None:
-            families.append(("crank", s_crank, crank_force))
+            families.append(("crank", c_crank, s_crank, crank_force))
         else:
             row = _core.CompiledScene.from_json(json.dumps(crank_layout.row_scene(self.scene)))
-            s_row = row.bearing_ratings("static")[1]
+            c_row, s_row = row.bearing_ratings()[1], row.bearing_ratings("static")[1]
             rows = crank_layout.rows(crank_force, ecc_force)
-            families += [(f"crank_{side}", s_row, rows[:, :, j]) for j, side in enumerate("ab")]
+            families += [(f"crank_{side}", c_row, s_row, rows[:, :, j]) for j, side in enumerate("ab")]
         return families
 
     def plot_bearing_loads(self, crank_layout: CrankLayout | None = None, ax: Axes | None = None) -> Figure:
@@ -208,14 +267,15 @@ class LtcaResult:
         """
         from ..plotting import new_figure
 
-        families = [f for f in self._bearing_families(crank_layout) if f[1] is not None]
+        families = [(name, static, forces) for name, _, static, forces in self._bearing_families(crank_layout)
+                    if static is not None]
         fig, ax = new_figure((8.0, 4.5)) if ax is None else (ax.figure, ax)
         angle = np.degrees(self.arrays["crank_angle"])
         ratings: dict[float, list[int]] = {}  # one line per rating (the crank's two rows share theirs)
         for k, (name, static, forces) in enumerate(families):
             mag = np.linalg.norm(forces, axis=-1).reshape(len(angle), -1).max(axis=1)
             ax.plot(angle, mag / 1e3, marker="." if len(angle) < 50 else None, color=f"C{k}", label=name)
-            ratings.setdefault(float(static), []).append(k)  # type: ignore[arg-type]
+            ratings.setdefault(float(static), []).append(k)
         for static, ks in ratings.items():
             ax.axhline(static / 1e3, color=f"C{ks[0]}" if len(ks) == 1 else "k", ls="--", lw=0.8,
                        label=", ".join(families[k][0] for k in ks) + " C0r")
