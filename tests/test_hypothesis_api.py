@@ -375,6 +375,22 @@ def test_ltca_bearing_safety(za, zb, zd, zp, length):
         assert all(v["static_safety"] >= 0 and v["peak_load"] >= 0 for v in out.values())
 
 
+_PERIOD: list[rvdyn.analysis.LtcaResult] = []
+
+
+@SETTINGS
+@given(st.one_of(st.none(), any_real, st.floats(1.0, 1e3)), position, position)
+def test_ltca_bearing_life(speed, za, zb):
+    if not _PERIOD:
+        period = rvdyn.ltca(rvdyn.Scene.physical("rated"), crank_angles=[0.0]).mesh_period
+        _PERIOD.append(rvdyn.ltca(rvdyn.Scene.physical("rated"), crank_angles=np.arange(12) * period / 12))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # s0 below 1 for some layouts
+        check("LtcaResult.bearing_life", lambda: _unloaded_is_safe(_PERIOD[0].bearing_life(speed=speed)))
+        check("LtcaResult.bearing_life (layout)", lambda: _unloaded_is_safe(_PERIOD[0].bearing_life(
+            speed=speed, crank_layout=rvdyn.CrankLayout(bearings=(za, zb), discs=(-0.02, 0.02), planet=-0.09))))
+
+
 def _unloaded_is_safe(safety: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
     """s0 is inf exactly where a bearing carries nothing (a layout that puts every load on the
     other bearing); 0 stands for it in the finiteness check."""
@@ -382,6 +398,13 @@ def _unloaded_is_safe(safety: dict[str, dict[str, float]]) -> dict[str, dict[str
         if v["static_safety"] == math.inf:
             assert v["peak_load"] == 0.0, v
             v["static_safety"] = 0.0
+        # An infinite life likewise for a bearing that carries next to nothing (a layout far
+        # off puts every load on the other bearing: 1e-86 N gives L10 1e302, hours beyond
+        # the floats).
+        for key in ("l10_million_revolutions", "l10_hours"):
+            if v.get(key) == math.inf and "equivalent_load" in v:
+                assert v["equivalent_load"] < 1e-6 * v["rating"], v
+                v[key] = 0.0
     return safety
 
 

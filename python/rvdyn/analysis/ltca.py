@@ -169,7 +169,8 @@ class LtcaResult:
         the crank angles: the same entries as :meth:`rvdyn.Result.bearing_life` (peak and
         equivalent load, ratings, static safety, ``L10`` in million revolutions and hours, and
         with a crank layout ``crank_a``, ``crank_b`` and ``crank_pair``), for steady running at
-        the input ``speed`` [rad/s] (default: the scene's constant drive speed).
+        the input ``speed`` [rad/s, magnitude 1e-9 to 1e9] (default: the scene's constant drive
+        speed).
 
         Each crank angle stands for an equal share of the rings' revolutions (the rings turn
         relative to each other by ``zp/zc`` of the crank angle, docs/model.md "Crank bearing
@@ -203,10 +204,11 @@ class LtcaResult:
             speed = float(drive["speed"])
         try:
             omega = abs(float(speed))
-        except (TypeError, ValueError) as exc:
+        except (TypeError, ValueError, OverflowError) as exc:
             raise ParameterError(f"speed must be the input speed in rad/s, got {speed!r}") from exc
-        if not (math.isfinite(omega) and omega > 0):
-            raise ParameterError(f"speed must be a finite, non-zero input speed [rad/s], got {speed!r}")
+        # Beyond these the hours leave the floats (1e-9 rad/s: a revolution in 200 years).
+        if not (1e-9 <= omega <= 1e9):
+            raise ParameterError(f"speed must be an input speed from 1e-9 to 1e9 rad/s in magnitude, got {speed!r}")
         zp = int((self.scene or {})["cycloid"]["pins"])
         ring_turn = float(step) * zp / (zp - 1) / (2 * math.pi)  # ring revolutions per crank angle step
         # The input turns with the crank angle as the held input's kinematics say.
