@@ -749,3 +749,27 @@ def test_empty_assembly_error_lists_take_their_shape_from_the_scene() -> None:
     cols = [v.column for v in lay.variables]
     assert cols[:3] == [f"errors.crank_eccentricity.{i}" for i in range(3)]
     assert len(cols) == 3 + 3 * 2 * 2 + 3 * 2
+
+
+def test_ltca_kernel_bearing_metrics_equal_the_ltcas_bearing_life() -> None:
+    # With bearings=True the kernel adds the shortest rating life and the smallest static
+    # safety of LtcaResult.bearing_life over one mesh period at the kernel's crank angles
+    # (84 on the physical preset: two per tooth-mesh cycle of its ISO mesh); a study gets them
+    # as columns, with their units.
+    import warnings
+
+    scene = rvdyn.Scene.physical("rated")
+    kernel = rvdyn.study.LtcaKernel(bearings=True)
+    assert kernel.metrics == tuple(rvdyn.study.LTCA_METRICS) + tuple(rvdyn.study.LTCA_BEARING_METRICS)
+    got = kernel(scene)
+    period = rvdyn.ltca(scene, crank_angles=[0.0]).mesh_period
+    n = rvdyn.analysis.tooth_mesh_angles(scene)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        life = rvdyn.ltca(scene, crank_angles=period * np.arange(n) / n).bearing_life()
+    assert got["bearing_l10_hours_min"] == min(v["l10_hours"] for v in life.values())
+    assert got["bearing_static_safety_min"] == min(v["static_safety"] for v in life.values())
+    assert rvdyn.study.kernels.metric_units(kernel)["bearing_l10_hours_min"] == "h"
+    assert "bearing_l10_hours_min" not in rvdyn.study.LtcaKernel()(rvdyn.Scene.paper("rated"))
+    with pytest.raises(rvdyn.ParameterError, match="bearings must be True or False"):
+        rvdyn.study.LtcaKernel(bearings=1)  # type: ignore[arg-type]

@@ -68,7 +68,9 @@ def run(scene: Scene, kernel: Any = "dynamic", tolerances: Sequence[Tolerance | 
     scene: the nominal :class:`rvdyn.Scene`. kernel: ``"dynamic"`` (a dynamic run reduced to
     :data:`rvdyn.study.DYNAMIC_METRICS`; ``kernel_options`` e.g. ``{"t_end": 0.5}``), ``"ltca"``
     (:class:`rvdyn.study.LtcaKernel`, :data:`rvdyn.study.LTCA_METRICS`; options ``torque``,
-    ``points``, ``twist_points``, ``crank_angle``), a kernel object, or a picklable top-level function ``f(scene) -> dict``.
+    ``points``, ``twist_points``, ``crank_angle``, ``window``, ``bearings``: with it also
+    :data:`rvdyn.study.LTCA_BEARING_METRICS`), a kernel object, or a picklable top-level
+    function ``f(scene) -> dict``.
     tolerances: :class:`Tolerance` s (or dicts) over dotted scene paths; correlations:
     :class:`Correlation` groups. samples: a count (Monte Carlo), ``MonteCarlo(n)``,
     ``LatinHypercube(n)`` or ``"lhs:N"``. seed: the design depends on it alone.

@@ -23,7 +23,7 @@ from ..errors import ParameterError
 from ..scene import Scene
 
 __all__ = ["DynamicKernel", "LtcaKernel", "FunctionKernel", "KERNELS", "register_kernel", "get_kernel",
-           "DYNAMIC_METRICS", "LTCA_METRICS"]
+           "DYNAMIC_METRICS", "LTCA_METRICS", "LTCA_BEARING_METRICS"]
 
 #: Metrics of :class:`DynamicKernel`, evaluated on the window [t_start, t_end] (SI units).
 DYNAMIC_METRICS: dict[str, str] = {
@@ -109,10 +109,11 @@ def metric_units(kernel: Any) -> dict[str, str]:
     units = getattr(kernel, "units", None)
     if isinstance(units, Mapping):
         return {str(k): str(v) for k, v in units.items()}
-    docs = {DynamicKernel: DYNAMIC_METRICS, LtcaKernel: LTCA_METRICS}.get(type(kernel), {})
+    docs = {DynamicKernel: DYNAMIC_METRICS, LtcaKernel: {**LTCA_METRICS, **LTCA_BEARING_METRICS}}.get(type(kernel), {})
     out: dict[str, str] = {}
+    metrics = set(getattr(kernel, "metrics", None) or docs)
     for name, text in docs.items():
-        if text.endswith("]") and "[" in text:
+        if name in metrics and text.endswith("]") and "[" in text:
             out[name] = text[text.rindex("[") + 1:-1]
     return out
 
@@ -154,6 +155,13 @@ LTCA_METRICS: dict[str, str] = {
     "lost_motion": "catalogue lost motion of the torque-twist loop [rad]",
 }
 
+#: Metrics :class:`LtcaKernel` adds with ``bearings=True`` (:meth:`rvdyn.analysis.LtcaResult.bearing_life`
+#: over one mesh period at +torque, steady running at the scene's drive speed, the scene's crank layout).
+LTCA_BEARING_METRICS: dict[str, str] = {
+    "bearing_l10_hours_min": "shortest ISO 281 rating life of the bearing families (a crank's two rows as a system) [h]",
+    "bearing_static_safety_min": "smallest ISO 76 static safety s0 of the bearing families [-]",
+}
+
 
 @dataclass(frozen=True)
 class LtcaKernel:
@@ -168,14 +176,17 @@ class LtcaKernel:
     [rad]. window: the TE over the window after which it repeats (with roller bearings, whose
     roller sets stay fixed in the frame, several mesh periods: twelve on the physical preset
     without pin errors, twelve times the cost) or, with ``window=False``, over one mesh period.
-    A sample whose analysis fails (no equilibrium, invalid geometry) raises its error, which the
-    study records in the sample's row."""
+    bearings: also the bearings' life and static safety (:data:`LTCA_BEARING_METRICS`, from an
+    LTCA at ``points`` crank angles over one mesh period; needs roller bearings and a constant
+    drive speed). A sample whose analysis fails (no equilibrium, invalid geometry) raises its
+    error, which the study records in the sample's row."""
 
     torque: float | None = None
     points: int = 24
     twist_points: int = 41
     crank_angle: float = 0.0
     window: bool = True
+    bearings: bool = False
     name: str = field(default="ltca", init=False)
 
     def __post_init__(self) -> None:
@@ -190,10 +201,12 @@ class LtcaKernel:
             raise ParameterError(f"ltca kernel: crank_angle must be a finite angle [rad], got {self.crank_angle!r}")
         if not isinstance(self.window, bool):
             raise ParameterError(f"ltca kernel: window must be True or False, got {self.window!r}")
+        if not isinstance(self.bearings, bool):
+            raise ParameterError(f"ltca kernel: bearings must be True or False, got {self.bearings!r}")
 
     @property
     def metrics(self) -> tuple[str, ...]:
-        return tuple(LTCA_METRICS)
+        return tuple(LTCA_METRICS) + (tuple(LTCA_BEARING_METRICS) if self.bearings else ())
 
     def __call__(self, scene: Scene) -> dict[str, float]:
         # The computations of rvdyn.analysis.transmission_error (its loaded part, with the
@@ -214,7 +227,7 @@ class LtcaKernel:
         pp = {k: float(e["max"] - e["min"]) for k, e in te["extremes"].items()}
         pins = te["pin_loads"]["forward"]
         loop = solver.twist_loop(torque, float(self.crank_angle), self.twist_points)
-        return {
+        out = {
             "te_pp_forward": pp["forward"],
             "te_pp_reverse": pp["reverse"],
             "peak_pin_force": float(np.max(pins["peak_force"])),
@@ -222,6 +235,18 @@ class LtcaKernel:
             "torsional_rigidity": float(loop["rigidity"]),
             "lost_motion": float(loop["lost_motion"]),
         }
+        if self.bearings:
+            import warnings
+
+            from ..analysis.ltca import ltca
+
+            angles = period * np.arange(points) / points
+            with warnings.catch_warnings():  # s0 below 1 is a metric here, not a warning per sample
+                warnings.simplefilter("ignore", RuntimeWarning)
+                life = ltca(sc, torque, angles).bearing_life()
+            out["bearing_l10_hours_min"] = min(v["l10_hours"] for v in life.values())
+            out["bearing_static_safety_min"] = min(v["static_safety"] for v in life.values())
+        return out
 
 
 #: Kernel factories by name: ``factory(**options) -> kernel``.
