@@ -316,3 +316,23 @@ def test_ltca_bearing_life_needs_whole_periods_and_a_speed() -> None:
                        crank_angles=np.arange(12) * period / 12)
     with pytest.raises(ParameterError, match="constant speed"):
         table.bearing_life()
+
+
+def test_a_runs_bearing_load_plot_draws_its_worst_bearings_over_time(steady_run: rvdyn.Result) -> None:
+    lines = {line.get_label(): line for line in steady_run.plot_bearing_loads().axes[0].get_lines()}
+    assert sorted(lines) == ["crank", "crank C0r", "eccentric", "eccentric C0r"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        life = steady_run.bearing_life(t_start=0.0)  # the peak over the whole run
+    for name, force in (("crank", steady_run.crank_bearing_force), ("eccentric", steady_run.eccentric_bearing_force)):
+        x, y = (np.asarray(v, dtype=float) for v in lines[name].get_data())
+        assert np.array_equal(x, steady_run.t)
+        np.testing.assert_allclose(y, np.linalg.norm(force, axis=-1).reshape(len(x), -1).max(axis=1) / 1e3, rtol=1e-15)
+        assert y.max() == pytest.approx(life[name]["peak_load"] / 1e3, rel=1e-15)
+        assert lines[f"{name} C0r"].get_ydata()[0] == pytest.approx(life[name]["static_rating"] / 1e3, rel=1e-15)
+    split = steady_run.plot_bearing_loads(CrankLayout(bearings=(-0.06, 0.06), discs=(-0.02, 0.02), planet=-0.09))
+    assert sorted(line.get_label() for line in split.axes[0].get_lines()) == [
+        "crank_a", "crank_a, crank_b C0r", "crank_b", "eccentric", "eccentric C0r"]
+    r = rvdyn.simulate(Scene.paper("rated"), 0.002, channels=["motion", "bearings"], progress=False)
+    with pytest.raises(ParameterError, match="rollers"):
+        r.plot_bearing_loads()

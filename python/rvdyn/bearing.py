@@ -180,3 +180,28 @@ def rate_lives(caller: str, families: list[Family], duration: float) -> dict[str
             "l10_million_revolutions": pair[worst],
             "l10_hours": pair[worst] * 1e6 / (60.0 * rpm) if rpm > 0 else math.inf}
     return out
+
+
+def plot_family_loads(ax: Any, x: NDArray[np.float64], families: list[tuple[str, float, NDArray[np.float64]]],
+                      xlabel: str, title: str) -> Any:
+    """Draw, against ``x`` (n,), the largest load [kN] over the bearings of each family
+    ``(name, C0r [N], forces (n, ..., 2) [N])`` and each C0r as a dashed line (one line per
+    rating, black where families share it, as the crank's two rows do) into ``ax`` (None: a new
+    figure); returns the figure."""
+    from .plotting import new_figure
+
+    fig, ax = new_figure((8.0, 4.5)) if ax is None else (ax.figure, ax)
+    ratings: dict[float, list[int]] = {}  # one line per rating
+    for k, (name, static, forces) in enumerate(families):
+        mag = np.linalg.norm(forces, axis=-1).reshape(len(x), -1).max(axis=1)
+        ax.plot(x, mag / 1e3, marker="." if len(x) < 50 else None, color=f"C{k}", label=name)
+        ratings.setdefault(float(static), []).append(k)
+    for static, ks in ratings.items():
+        ax.axhline(static / 1e3, color=f"C{ks[0]}" if len(ks) == 1 else "k", ls="--", lw=0.8,
+                   label=", ".join(families[k][0] for k in ks) + " C0r")
+    ax.set_ylim(bottom=0.0)  # loads against ratings from zero: the margin is seen in proportion
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("load of the most loaded bearing [kN]")
+    ax.set_title(title)
+    ax.legend(fontsize="small")
+    return fig

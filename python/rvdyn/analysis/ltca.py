@@ -267,26 +267,13 @@ class LtcaResult:
         >>> [line.get_label() for line in fig.axes[0].get_lines()]
         ['eccentric', 'crank', 'eccentric C0r', 'crank C0r']
         """
-        from ..plotting import new_figure
+        from ..bearing import plot_family_loads
 
         families = [(name, static, forces) for name, _, static, forces in self._bearing_families(crank_layout)
                     if static is not None]
-        fig, ax = new_figure((8.0, 4.5)) if ax is None else (ax.figure, ax)
-        angle = np.degrees(self.arrays["crank_angle"])
-        ratings: dict[float, list[int]] = {}  # one line per rating (the crank's two rows share theirs)
-        for k, (name, static, forces) in enumerate(families):
-            mag = np.linalg.norm(forces, axis=-1).reshape(len(angle), -1).max(axis=1)
-            ax.plot(angle, mag / 1e3, marker="." if len(angle) < 50 else None, color=f"C{k}", label=name)
-            ratings.setdefault(float(static), []).append(k)
-        for static, ks in ratings.items():
-            ax.axhline(static / 1e3, color=f"C{ks[0]}" if len(ks) == 1 else "k", ls="--", lw=0.8,
-                       label=", ".join(families[k][0] for k in ks) + " C0r")
-        ax.set_ylim(bottom=0.0)  # loads against ratings from zero: the margin is seen in proportion
-        ax.set_xlabel("crank angle [deg]")
-        ax.set_ylabel("load of the most loaded bearing [kN]")
-        ax.set_title(f"bearing loads and ISO 76 static ratings, T = {self.torque / 1e3:.2f} kN m")
-        ax.legend(fontsize="small")
-        return fig  # type: ignore[return-value]
+        fig: Figure = plot_family_loads(ax, np.degrees(self.arrays["crank_angle"]), families, "crank angle [deg]",
+                                        f"bearing loads and ISO 76 static ratings, T = {self.torque / 1e3:.2f} kN m")
+        return fig
 
     def worst_index(self, disc: int = 0) -> int:
         """Index of the crank angle with the largest pin force on ``disc``."""
