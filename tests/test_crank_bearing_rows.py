@@ -312,6 +312,9 @@ def test_ltca_bearing_life_needs_whole_periods_and_a_speed() -> None:
     for speed in (0.0, math.nan, "fast"):
         with pytest.raises(ParameterError, match="speed"):
             two.bearing_life(speed=speed)  # type: ignore[arg-type]
+    bare = dataclasses.replace(two, scene=None)
+    with pytest.raises(ParameterError, match="carries no scene"):
+        bare.bearing_life(speed=100.0)
     table = rvdyn.ltca(scene.replace(drive={"kind": "torque", "torque": 770.0}),
                        crank_angles=np.arange(12) * period / 12)
     with pytest.raises(ParameterError, match="constant speed"):

@@ -139,7 +139,7 @@ def static_safety(caller: str, family: str, peak: float, static: float, remedy: 
 #: One bearing family to rate (:func:`rate_lives`): name, ISO 281 rating ``C`` [N] and ISO 76
 #: static rating ``C0r`` [N] (None without rollers), peak load [N], and per interval the load
 #: [N] and the revolutions of the rings [-], shape (intervals, bearings...).
-Family = tuple[str, "float | None", "float | None", float, NDArray[np.float64], NDArray[np.float64]]
+Family = tuple[str, float | None, float | None, float, NDArray[np.float64], NDArray[np.float64]]
 
 
 def rate_lives(caller: str, families: list[Family], duration: float) -> dict[str, dict[str, float]]:

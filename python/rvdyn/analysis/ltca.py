@@ -187,6 +187,7 @@ class LtcaResult:
         """
         from ..bearing import Family, rate_lives
 
+        families = self._bearing_families(crank_layout)  # its refusals first (no scene, rigid joints)
         psi = np.asarray(self.arrays["crank_angle"], dtype=float)
         n = psi.size
         step = (psi[-1] - psi[0]) / (n - 1) if n > 1 else 0.0
@@ -195,7 +196,7 @@ class LtcaResult:
                 or abs(periods - round(periods)) > 1e-6 or round(periods) < 1):
             raise ParameterError(
                 f"bearing_life needs crank angles equally spaced over whole mesh periods ({self.mesh_period:.6g} "
-                f"rad each), as rvdyn.ltca(scene, torque, crank_angles=N) gives; got {n} angle(s) covering "
+                f"rad each), as rvdyn.ltca(scene, torque) gives (90 over one); got {n} angle(s) covering "
                 f"{periods:.4g} period(s)")
         if speed is None:
             drive = (self.scene or {}).get("drive", {})
@@ -209,14 +210,14 @@ class LtcaResult:
         # Beyond these the hours leave the floats (1e-9 rad/s: a revolution in 200 years).
         if not (1e-9 <= omega <= 1e9):
             raise ParameterError(f"speed must be an input speed from 1e-9 to 1e9 rad/s in magnitude, got {speed!r}")
-        zp = int((self.scene or {})["cycloid"]["pins"])
+        zp = int(self.scene["cycloid"]["pins"])  # type: ignore[index]
         ring_turn = float(step) * zp / (zp - 1) / (2 * math.pi)  # ring revolutions per crank angle step
         # The input turns with the crank angle as the held input's kinematics say.
         inputs = np.asarray(self.arrays["input_angle"], dtype=float)
         input_per_psi = abs(float(inputs[-1] - inputs[0])) / float(psi[-1] - psi[0])
         duration = float(n * step * input_per_psi / omega)  # [s] for the cycle at this speed
         rated: list[Family] = []
-        for name, rating, static, forces in self._bearing_families(crank_layout):
+        for name, rating, static, forces in families:
             mag = np.linalg.norm(forces, axis=-1)
             rated.append((name, rating, static, float(mag.max()), mag, np.full(mag.shape, ring_turn)))
         return rate_lives("bearing_life", rated, duration)
