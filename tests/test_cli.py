@@ -70,8 +70,13 @@ def test_info_text():
     top = lines.index("Presets side by side (rated load)")
     head = lines[top + 1]
     cols = [head.index("paper"), head.index("physical")]
-    body = lines[top + 2:top + 8]
-    assert body[0].strip().startswith("pin contact law") and body[-1].strip().startswith("main torsional mode")
+    body = lines[top + 2:top + 9]
+    assert body[0].strip().startswith("pin contact law") and body[-1].strip().startswith("bearing life")
+    # The physical preset's lives are the LTCA's (LtcaResult.bearing_life), s0 with them.
+    import rvdyn
+
+    life = rvdyn.ltca(rvdyn.Scene.physical("rated")).bearing_life()
+    assert f"eccentric {life['eccentric']['l10_hours']:.1f} h (s0 {life['eccentric']['static_safety']:.2f})" in body[-1]
     for line in body:
         for c in cols:
             assert line[c - 2:c] == "  " and line[c] != " ", (line, c)

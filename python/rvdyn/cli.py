@@ -116,6 +116,12 @@ def info_data() -> dict[str, Any]:
         f"{main.frequency[0]:.0f} Hz, damping ratio {main.damping_ratio[0]:.3f} "
         "(linearised, rated load, crank angle 0)"
     )
+    # Computed too: ISO 281 lives of the roller bearings at rated torque and speed, from the
+    # LTCA over one mesh period (about 10 ms; LtcaResult.bearing_life).
+    presets["paper"]["bearing_life"] = "none (rigid joints)"
+    life = rvdyn.ltca(rvdyn.Scene.physical("rated")).bearing_life()
+    presets["physical"]["bearing_life"] = ", ".join(
+        f"{name} {v['l10_hours']:.1f} h (s0 {v['static_safety']:.2f})" for name, v in life.items()) + " (L10, ISO 281)"
     presets["note"] = (
         "the paper preset keeps the paper's IMPACT law only to reproduce the paper: its stiffness "
         "k' sqrt(w) from eqs. 5-11 has units N/mm but is read as N/mm^1.5, and it makes the pins "
@@ -213,6 +219,7 @@ def _format_presets(p: dict[str, Any]) -> list[str]:
          f"{a['mesh_stiffness_N_per_m']:.3e} N/m", f"{b['mesh_stiffness_N_per_m']:.3e} N/m"),
         ("pin damping", a["damping"], b["damping"]),
         ("main torsional mode", a["main_torsional_mode"], b["main_torsional_mode"]),
+        ("bearing life at rated torque and speed", a["bearing_life"], b["bearing_life"]),
     ]
     # Columns as wide as their longest entry, so that no entry runs into the next.
     w0, w1 = (max(len(r[k]) for r in rows) for k in (0, 1))
