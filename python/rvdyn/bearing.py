@@ -11,6 +11,7 @@ given to them or carried by the scene (its field ``crank_layout``, docs/scene.md
 
 from __future__ import annotations
 
+import json
 import math
 import warnings
 from dataclasses import dataclass
@@ -134,6 +135,33 @@ def static_safety(caller: str, family: str, peak: float, static: float, remedy: 
             f"rating C0r = {static / 1e3:.1f} kN (static safety s0 = {s0:.2f} < 1): the raceways yield there "
             f"and the elastic roller law and the forces do not hold; {remedy}", RuntimeWarning, stacklevel=3)
     return s0
+
+
+def families(scene: dict[str, Any], crank_force: NDArray[np.float64], eccentric_force: NDArray[np.float64],
+             crank_layout: CrankLayout | None) -> list[tuple[str, float | None, float | None, NDArray[np.float64]]]:
+    """The bearing families of a run or an LTCA of ``scene`` (a dict): name, ISO 281 rating
+    ``C`` and ISO 76 static rating ``C0r`` [N] (None for a family without rollers) and forces
+    (n, ..., 2) [N]: ``"eccentric"``, and ``"crank"`` or, split by ``crank_layout`` (default the
+    scene's, :meth:`CrankLayout.of_scene`), ``"crank_a"`` and ``"crank_b"``, each rated as one
+    row of ``crank_layout.roller_length``. ``ParameterError`` if no bearing has rollers."""
+    compiled = _core.CompiledScene.from_json(json.dumps(scene))
+    (c_ecc, c_crank), (s_ecc, s_crank) = compiled.bearing_ratings(), compiled.bearing_ratings("static")
+    if c_ecc is None and c_crank is None:
+        raise ParameterError(
+            "no bearing of this scene is built from rollers, so there is no ISO 281 or ISO 76 rating: give "
+            "joints.eccentric_bearing.rollers (and joints.crank_bearing.rollers), as Scene.physical does; "
+            "the bearing forces are in eccentric_bearing_force and crank_bearing_force")
+    out: list[tuple[str, float | None, float | None, NDArray[np.float64]]] = [
+        ("eccentric", c_ecc, s_ecc, eccentric_force)]
+    layout = crank_layout if crank_layout is not None else CrankLayout.of_scene(scene)
+    if layout is None:
+        out.append(("crank", c_crank, s_crank, crank_force))
+    else:
+        row = _core.CompiledScene.from_json(json.dumps(layout.row_scene(scene)))
+        c_row, s_row = row.bearing_ratings()[1], row.bearing_ratings("static")[1]
+        rows = layout.rows(crank_force, eccentric_force)
+        out += [(f"crank_{side}", c_row, s_row, rows[..., j, :]) for j, side in enumerate("ab")]
+    return out
 
 
 #: One bearing family to rate (:func:`rate_lives`): name, ISO 281 rating ``C`` [N] and ISO 76

@@ -347,15 +347,7 @@ class Result:
         as a system (Lundberg-Palmgren, ``(L_a^-9/8 + L_b^-9/8)^(-8/9)``) and the smaller
         ``static_safety`` of the two. The lumped entry hides the discs' tilting moment and
         rates the two bearings as one row, so it overstates their life and static safety."""
-        compiled = _core.CompiledScene.from_json(json.dumps(self.scene))
-        c_ecc, c_crank = compiled.bearing_ratings()
-        s_ecc, s_crank = compiled.bearing_ratings("static")
-        if c_ecc is None and c_crank is None:
-            raise ParameterError(
-                "no bearing of this scene is built from rollers, so there is no ISO 281 rating: "
-                "give joints.eccentric_bearing.rollers (and joints.crank_bearing.rollers), as "
-                "Scene.physical does; the bearing forces are in eccentric_bearing_force and "
-                "crank_bearing_force")
+        families = self._bearing_families(crank_layout)  # its refusals before any other work
         if t_start is None:
             try:
                 t0 = self.steady_window()[0]
@@ -377,9 +369,7 @@ class Result:
                 "(steady_window): run longer for a life that does not depend on the window",
                 RuntimeWarning, stacklevel=2)
         duration = float(t[-1] - t[0])
-        families = [(name, rating, static, forces[i0:], rel[i0:])
-                    for name, rating, static, forces, rel in self._bearing_families(crank_layout, c_ecc, c_crank,
-                                                                                    s_ecc, s_crank)]
+        families = [(name, rating, static, forces[i0:], rel[i0:]) for name, rating, static, forces, rel in families]
         # Per interval between samples: the mean load and the rings' revolutions.
         rated: list[Family] = [
             (name, rating, static, float(np.linalg.norm(forces, axis=-1).max()),
@@ -389,28 +379,18 @@ class Result:
         return rate_lives("bearing_life", rated, duration)
 
     def _bearing_families(
-            self, crank_layout: CrankLayout | None, c_ecc: float | None, c_crank: float | None,
-            s_ecc: float | None, s_crank: float | None,
+            self, crank_layout: CrankLayout | None,
     ) -> list[tuple[str, float | None, float | None, NDArray[np.float64], NDArray[np.float64]]]:
-        """Each bearing family over the whole run: name, ISO 281 and ISO 76 ratings [N], forces
-        (n, ..., 2) [N] and the relative angle of its rings (n, ...) [rad]; the crank bearing
-        split by ``crank_layout`` (default the scene's) as :meth:`bearing_life` says."""
+        """:func:`rvdyn.bearing.families` over the whole run, each with the relative angle of its
+        rings (n, ...) [rad]: eccentric (crank against disc) or crank (crank against carrier)."""
+        from .bearing import families
+
         crank = self.crank_angle
         crank_rel = crank - self.carrier_angle[:, None]
-        families: list[tuple[str, float | None, float | None, NDArray[np.float64], NDArray[np.float64]]] = [
-            ("eccentric", c_ecc, s_ecc, self.eccentric_bearing_force, crank[:, :, None] - self.disc_angle[:, None, :])]
-        if crank_layout is None:
-            from .bearing import CrankLayout
-
-            crank_layout = CrankLayout.of_scene(self.scene)
-        if crank_layout is None:
-            families.append(("crank", c_crank, s_crank, self.crank_bearing_force, crank_rel))
-        else:
-            row = _core.CompiledScene.from_json(json.dumps(crank_layout.row_scene(self.scene)))
-            c_row, s_row = row.bearing_ratings()[1], row.bearing_ratings("static")[1]
-            rows = crank_layout.rows(self.crank_bearing_force, self.eccentric_bearing_force)
-            families += [(f"crank_{side}", c_row, s_row, rows[:, :, j], crank_rel) for j, side in enumerate("ab")]
-        return families
+        ecc_rel = crank[:, :, None] - self.disc_angle[:, None, :]
+        return [(name, rating, static, forces, ecc_rel if name == "eccentric" else crank_rel)
+                for name, rating, static, forces in families(self.scene, self.crank_bearing_force,
+                                                              self.eccentric_bearing_force, crank_layout)]
 
     def plot_bearing_loads(self, crank_layout: CrankLayout | None = None, ax: Any = None) -> Any:
         """The load [kN] of the most loaded bearing of each family (those of :meth:`bearing_life`,
@@ -420,14 +400,8 @@ class Result:
         channels and roller bearings (``ParameterError`` otherwise)."""
         from .bearing import plot_family_loads
 
-        compiled = _core.CompiledScene.from_json(json.dumps(self.scene))
-        (c_ecc, c_crank), (s_ecc, s_crank) = compiled.bearing_ratings(), compiled.bearing_ratings("static")
-        if s_ecc is None and s_crank is None:
-            raise ParameterError("no bearing of this scene is built from rollers, so there is no ISO 76 static "
-                                 "rating to draw: give joints.eccentric_bearing.rollers (and "
-                                 "joints.crank_bearing.rollers), as Scene.physical does")
-        families = [(name, static, forces) for name, _, static, forces, _ in
-                    self._bearing_families(crank_layout, c_ecc, c_crank, s_ecc, s_crank) if static is not None]
+        families = [(name, static, forces) for name, _, static, forces, _ in self._bearing_families(crank_layout)
+                    if static is not None]
         return plot_family_loads(ax, self.t, families, "time [s]", "bearing loads and ISO 76 static ratings")
 
     # -------------------------------------------------------------------- files

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -234,26 +233,9 @@ class LtcaResult:
         if crank_force.size == 0:
             raise ParameterError("the scene's joints are rigid, so the LTCA has no bearing forces: give "
                                  "compliant joints with rollers (joints.*.rollers), as Scene.physical has")
-        compiled = _core.CompiledScene.from_json(json.dumps(self.scene))
-        (c_ecc, c_crank), (s_ecc, s_crank) = compiled.bearing_ratings(), compiled.bearing_ratings("static")
-        if s_ecc is None and s_crank is None:
-            raise ParameterError(
-                "no bearing of this scene is built from rollers, so there is no ISO 76 static rating: give "
-                "joints.eccentric_bearing.rollers (and joints.crank_bearing.rollers), as Scene.physical "
-                "does; the bearing forces are in eccentric_bearing_force and crank_bearing_force")
-        families: list[tuple[str, float | None, float | None, np.ndarray]] = [("eccentric", c_ecc, s_ecc, ecc_force)]
-        if crank_layout is None:
-            from ..bearing import CrankLayout
+        from ..bearing import families
 
-            crank_layout = CrankLayout.of_scene(self.scene)
-        if crank_layout is None:
-            families.append(("crank", c_crank, s_crank, crank_force))
-        else:
-            row = _core.CompiledScene.from_json(json.dumps(crank_layout.row_scene(self.scene)))
-            c_row, s_row = row.bearing_ratings()[1], row.bearing_ratings("static")[1]
-            rows = crank_layout.rows(crank_force, ecc_force)
-            families += [(f"crank_{side}", c_row, s_row, rows[:, :, j]) for j, side in enumerate("ab")]
-        return families
+        return families(self.scene, crank_force, ecc_force, crank_layout)
 
     def plot_bearing_loads(self, crank_layout: CrankLayout | None = None, ax: Axes | None = None) -> Figure:
         """The load [kN] of the most loaded bearing of each family (:meth:`bearing_safety`'s
