@@ -165,6 +165,8 @@ def test_a_figure_drawn_again_has_the_pixels_of_a_new_one(short_run, idle_run, n
         (fresh,) = paper.Figures().write(load, paper._theory(scene), result, new, [name])
         a, b = (np.asarray(Image.open(p)) for p in (reused, fresh))
         assert a.shape == b.shape and np.array_equal(a, b), (name, k, load, int((a != b).sum()))
+    with pytest.raises(rvdyn.ParameterError, match="unknown paper figure 'speed'"):
+        reusing.draw("speed", "rated", 1.0, short_run[1])
 
 
 def test_thin_lines_keeps_first_last_and_extremes_of_every_pixel_column() -> None:

@@ -21,6 +21,7 @@ from typing import Any, Callable, Iterable, NamedTuple
 
 import numpy as np
 
+from .errors import ParameterError
 from .result import Result
 from .scene import Scene
 from .simulation import simulate
@@ -305,6 +306,8 @@ class Figures:
     def draw(self, name: str, load: str, theory: float, result: Result) -> Any:
         """The Figure of kind ``name`` for the run ``result`` of load case ``load``, whose
         theoretical output speed is ``theory`` [rad/s]; valid until the next call with ``name``."""
+        if name not in FIGURES:
+            raise ParameterError(f"unknown paper figure {name!r}: the figures are {sorted(FIGURES)}")
         kind = FIGURES[name]
         fig = self._made.get(name)
         if fig is None:
