@@ -93,6 +93,16 @@ fn bench_ltca_physical(c: &mut Criterion) {
             )
         })
     });
+    // `compliance_budget(scene)`: the warm equilibrium at the rated torque and its five family
+    // parts (one evaluation each, plus the whole tangent's).
+    c.bench_function("ltca_physical/compliance_budget_rated", |b| {
+        b.iter(|| {
+            black_box(
+                ltca.compliance_budget(&[black_box(torque)], 0.0)
+                    .expect("budget"),
+            )
+        })
+    });
 }
 
 criterion_group! {

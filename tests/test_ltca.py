@@ -166,10 +166,17 @@ def test_analyze_command_writes_figures_loads_and_summary(tmp_path: Path) -> Non
                         "--loop-points", "21"], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     for name in ("load_distribution.png", "contact_pressure.png", "transmission_error.png",
-                 "torque_twist.png", "fea_loads.csv", "fea_loads.json", "summary.md", "summary.json"):
+                 "torque_twist.png", "compliance_budget.png", "fea_loads.csv", "fea_loads.json", "summary.md",
+                 "summary.json"):
         assert (out / name).exists(), name
     summary = json.loads((out / "summary.json").read_text())
     assert summary["rigidity_Nm_per_arcmin"] > 0 and summary["scene"] == "physical"
+    # The compliance budget at the torque: every family of the physical preset, shares summing to 1.
+    budget = summary["compliance_budget"]
+    assert set(budget["share"]) == {"pin contacts", "sun/planet meshes", "eccentric bearings", "crank bearings"}
+    assert sum(budget["share"].values()) == pytest.approx(1.0, abs=1e-9)
+    assert budget["torque_Nm"] == pytest.approx(summary["torque_Nm"], rel=1e-12)
+    assert "compliance budget at" in (out / "summary.md").read_text()
     assert "LTCA: 12/12" in r.stderr
     # The TE figures are transmission_error's located extremes only (not also the samples'
     # peak-to-peak of the load sweep), and 12 angles are too few for the ISO tooth-mesh cycle.

@@ -545,6 +545,10 @@ class LtcaSolver:
     def twist_loop(self, rated: float, crank_angle: float, points: int, friction: bool = True) -> dict[str, Any]:
         """Torque-twist loop with rigidity, lost motion and backlash (with the scene's friction
         unless ``friction`` is false)."""
+    def compliance_budget(self, torques: list[float], crank_angle: float) -> dict[str, Any]:
+        """Compliance budget at ``crank_angle`` [rad] for each torque [N m]: ``parts``,
+        ``compliance`` (torques, parts) [rad/(N m)], ``torsional_stiffness`` [N m/rad] and
+        ``split_error`` (torques,)."""
     def friction_sweep(self, torque: float, crank_angles: list[float]) -> dict[str, Any]:
         """Running sweep with the scene's friction: TE [rad] and input torque [N m]."""
 

@@ -489,7 +489,7 @@ COMMANDS: list[Command] = [
     Command("paper", "run the paper's simulations on the default scene and write figures",
             _add_paper, _run_paper),
     Command("analyze", "quasi-static analysis: load distribution, TE both directions, "
-            "torque-twist loop, contact pressure, bearing loads, loads for FEA", _add_analyze, _run_analyze),
+            "torque-twist loop, compliance budget, contact pressure, bearing loads, loads for FEA", _add_analyze, _run_analyze),
     Command("study", "run a tolerance study from a TOML spec (table, statistics, plots)", _add_study,
             _run_study),
     Command("modes", "modes about the loaded equilibrium, energy shares, Campbell diagram",

@@ -193,6 +193,30 @@ impl LtcaSolver {
         Ok(d)
     }
 
+    /// The compliance budget at `crank_angle` [rad] for each output torque in `torques` [N m]:
+    /// `parts` (names), `compliance` (torques, parts) [rad/(N m)], `torsional_stiffness`
+    /// (torques,) [N m/rad], `split_error` (torques,).
+    fn compliance_budget<'py>(
+        &mut self,
+        py: Python<'py>,
+        torques: Vec<f64>,
+        crank_angle: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let ltca = self.ltca.get_mut().map_err(|_| poisoned())?;
+        let b = py.detach(|| ltca.compliance_budget(&torques, crank_angle))?;
+        let (m, p) = (b.torque.len(), b.parts.len());
+        let d = PyDict::new(py);
+        d.set_item("parts", b.parts)?;
+        let flat: Vec<f64> = b.compliance.into_iter().flatten().collect();
+        d.set_item("compliance", f64_array(py, flat, vec![m, p])?)?;
+        d.set_item(
+            "torsional_stiffness",
+            f64_array(py, b.torsional_stiffness, vec![m])?,
+        )?;
+        d.set_item("split_error", f64_array(py, b.split_error, vec![m])?)?;
+        Ok(d)
+    }
+
     /// A running sweep with the scene's friction at `crank_angles` [rad] under the output
     /// torque `torque` [N m] (the input driving against it): TE [rad] and the held input's
     /// torque [N m] per crank angle.

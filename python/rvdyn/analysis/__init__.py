@@ -1,6 +1,7 @@
 """Analyses of scenes and results: loaded tooth contact analysis (LTCA), transmission error in both
-drive directions, the torque-twist loop (rigidity, lost motion, backlash) and contact loads for
-FEA; order spectra of dynamic runs (:mod:`.spectrum`), modes about the loaded equilibrium
+drive directions, the torque-twist loop (rigidity, lost motion, backlash), the compliance budget
+(:mod:`.budget`: which parts the torsional compliance comes from) and contact loads for FEA;
+order spectra of dynamic runs (:mod:`.spectrum`), modes about the loaded equilibrium
 (:mod:`.modes`) and Campbell diagrams (:mod:`.campbell`). The equilibria are computed by the
 Rust core (``rvdyn._core``); docs/model.md, "Quasi-static analysis", gives the formulation and
 conventions.
@@ -13,6 +14,7 @@ Every analysis is callable under its own name here (``rvdyn.analysis.modes(scene
 
 from __future__ import annotations
 
+from .budget import ComplianceBudget, compliance_budget
 from .campbell import CampbellDiagram, Crossing, campbell, travel_to_input_speed
 from .ltca import (
     ARCMIN,
@@ -32,6 +34,8 @@ from .spectrum import ExcitationOrder, OrderSpectrum, SpectrumPeak, excitation_o
 
 __all__ = [
     "ARCMIN",
+    "ComplianceBudget",
+    "compliance_budget",
     "ARCSEC",
     "LtcaResult",
     "TeHarmonic",

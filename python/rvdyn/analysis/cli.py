@@ -1,5 +1,5 @@
 """``rvdyn analyze``: the quasi-static analysis of a scene (load distribution, TE in both
-directions, torque-twist loop, contact pressure, loads for FEA, summary)."""
+directions, torque-twist loop, compliance budget, contact pressure, loads for FEA, summary)."""
 
 from __future__ import annotations
 
@@ -54,6 +54,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ..plotting import save_figure
     from ..scene import Scene
+    from .budget import compliance_budget
     from .ltca import ARCMIN, ARCSEC, ltca, torque_twist, transmission_error
 
     if args.scene is not None:
@@ -93,11 +94,14 @@ def run(args: argparse.Namespace) -> int:
     te = transmission_error(scene, args.torque, args.angles, light=args.light)
     print("  torque-twist loop ...", file=sys.stderr)
     loop = torque_twist(scene, args.torque, 0.0, args.loop_points)
+    # Where the compliance comes from, from 5 % of the torque up (the loop's crank angle).
+    budget = compliance_budget(scene, res.torque * np.linspace(0.05, 1.0, 20), 0.0)
     files = [
         save_figure(res.plot_load_distribution(), str(out / "load_distribution.png")),
         save_figure(res.plot_contact_pressure(), str(out / "contact_pressure.png")),
         save_figure(te.plot(), str(out / "transmission_error.png")),
         save_figure(loop.plot(), str(out / "torque_twist.png")),
+        save_figure(budget.plot(), str(out / "compliance_budget.png")),
     ]
     csv_path, json_path = res.save_fea_loads(out)
     # Static safety at this torque where the bearings are built from rollers (ISO 76).
@@ -136,6 +140,7 @@ def run(args: argparse.Namespace) -> int:
         "te_mean_arcmin": {"forward": float(te.forward.mean()) / ARCMIN,
                            "reverse": float(te.reverse.mean()) / ARCMIN},
         **loop.summary(),
+        "compliance_budget": budget.summary(),
         "bearing_static_safety": bearings,
         "bearing_life": lives,
         # The layout that split the crank bearing into crank_a and crank_b [m], if any.
@@ -165,6 +170,9 @@ def run(args: argparse.Namespace) -> int:
         f"{summary['lost_motion_arcmin']:.3f} arcmin, backlash {summary['backlash_arcmin']:.3f} arcmin "
         f"(the loop runs to +-{abs(res.torque):.1f} N m, taken as the rated torque: rigidity between "
         f"the +-rated points, lost motion within +-3 % of it)",
+        f"- compliance budget at {res.torque:.1f} N m (tangent stiffness "
+        f"{summary['compliance_budget']['tangent_stiffness_Nm_per_arcmin']:.1f} N m/arcmin at crank angle 0): "
+        f"{budget.where()} (compliance_budget.png: the shares from 5 % of the torque up)",
         *([("- bearings at this torque (ISO 76 static safety s0 = C0r / peak load): " + "; ".join(
             f"{name.replace('_', ' ')} peak {b['peak_load'] / 1e3:.1f} kN, C0r {b['static_rating'] / 1e3:.1f} kN, "
             f"s0 {b['static_safety']:.2f}" for name, b in bearings.items())

@@ -11,6 +11,7 @@
 //! [N m] acts on the carrier against positive rotation (as the scene's load), so a positive
 //! `T` is the forward drive.
 
+pub mod budget;
 pub mod export;
 pub mod friction;
 mod gear_errors;
@@ -23,6 +24,7 @@ use std::f64::consts::{PI, TAU};
 use crate::contact::hertz::{Material, effective_modulus, hertz_line_strip};
 use crate::dynamics::scene::Scene;
 use crate::error::{Result, RvdynError, require_finite};
+pub use budget::ComplianceBudget;
 pub use newton::{NewtonOptions, NewtonReport};
 use newton::{Scratch, equilibrium, solve_dense};
 use rayon::prelude::*;

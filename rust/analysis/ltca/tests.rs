@@ -7,7 +7,7 @@ use crate::dynamics::scene::{ContactLawSpec, Joints};
 use crate::geometry::CycloidGeometry;
 
 /// A linear pin law `F = k x` (no damping at rest).
-fn linear(k: f64) -> ContactLawSpec {
+pub(super) fn linear(k: f64) -> ContactLawSpec {
     ContactLawSpec::Impact {
         stiffness: k,
         exponent: 1.0,

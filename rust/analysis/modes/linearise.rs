@@ -119,18 +119,7 @@ impl Linearizer {
     pub fn new(scene: &Scene) -> Result<Self> {
         let statics = Statics::new(scene)?;
         let ltca = Ltca::new(scene)?;
-        let mut families: Vec<(String, Family)> = (0..statics.model.discs.len())
-            .map(|d| (format!("pin contacts disc {d}"), Family::Pins(d)))
-            .collect();
-        if statics.model.mesh.is_some() {
-            families.push(("sun/planet meshes".into(), Family::Mesh));
-        }
-        if statics.kind == Kind::Compliant {
-            families.push(("eccentric bearings".into(), Family::EccentricBearings));
-            if statics.crank_bearing.is_some() {
-                families.push(("crank bearings".into(), Family::CrankBearings));
-            }
-        }
+        let families = statics.families();
         let mut free_scene = scene.clone();
         free_scene.drive = Drive::Torque {
             torque: 0.0,

@@ -327,6 +327,26 @@ impl Statics {
         }
     }
 
+    /// The families of couplings of this scene, named as in reports: the pin contacts of each
+    /// disc, the sun/planet meshes (with a first stage), the eccentric bearings (compliant
+    /// joints) and the crank bearings (when compliant). Their stiffness parts sum to the whole
+    /// tangent.
+    pub fn families(&self) -> Vec<(String, Family)> {
+        let mut families: Vec<(String, Family)> = (0..self.model.discs.len())
+            .map(|d| (format!("pin contacts disc {d}"), Family::Pins(d)))
+            .collect();
+        if self.model.mesh.is_some() {
+            families.push(("sun/planet meshes".into(), Family::Mesh));
+        }
+        if self.kind == Kind::Compliant {
+            families.push(("eccentric bearings".into(), Family::EccentricBearings));
+            if self.crank_bearing.is_some() {
+                families.push(("crank bearings".into(), Family::CrankBearings));
+            }
+        }
+        families
+    }
+
     /// Number of unknowns.
     pub fn dim(&self) -> usize {
         self.scale.len()
