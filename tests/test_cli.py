@@ -70,13 +70,18 @@ def test_info_text():
     top = lines.index("Presets side by side (rated load)")
     head = lines[top + 1]
     cols = [head.index("paper"), head.index("physical")]
-    body = lines[top + 2:top + 9]
-    assert body[0].strip().startswith("pin contact law") and body[-1].strip().startswith("bearing life")
+    body = lines[top + 2:top + 10]
+    assert body[0].strip().startswith("pin contact law") and body[-1].strip().startswith("torsional stiffness")
     # The physical preset's lives are the LTCA's (LtcaResult.bearing_life), s0 with them.
     import rvdyn
+    from rvdyn.analysis import ARCMIN, compliance_budget
 
     life = rvdyn.ltca(rvdyn.Scene.physical("rated")).bearing_life()
-    assert f"eccentric {life['eccentric']['l10_hours']:.1f} h (s0 {life['eccentric']['static_safety']:.2f})" in body[-1]
+    assert f"eccentric {life['eccentric']['l10_hours']:.1f} h (s0 {life['eccentric']['static_safety']:.2f})" in body[-2]
+    # The stiffness and its largest part are the compliance budget's.
+    b = compliance_budget(rvdyn.Scene.physical("rated")).grouped()
+    top_part = b.table()[0]
+    assert f"{b.torsional_stiffness[0] * ARCMIN:.0f} N m/arcmin: {top_part['part']} {100 * top_part['share']:.0f} %" in body[-1]
     for line in body:
         for c in cols:
             assert line[c - 2:c] == "  " and line[c] != " ", (line, c)

@@ -122,6 +122,14 @@ def info_data() -> dict[str, Any]:
     life = rvdyn.ltca(rvdyn.Scene.physical("rated")).bearing_life()
     presets["physical"]["bearing_life"] = ", ".join(
         f"{name} {v['l10_hours']:.1f} h (s0 {v['static_safety']:.2f})" for name, v in life.items()) + " (L10, ISO 281)"
+    # Where each preset's torsional compliance comes from (compliance budget, about 1 ms each).
+    from .analysis.budget import compliance_budget
+    from .analysis.ltca import ARCMIN
+
+    for name, scene in (("paper", rvdyn.Scene.paper("rated")), ("physical", rvdyn.Scene.physical("rated"))):
+        budget = compliance_budget(scene).grouped()
+        presets[name]["torsional_stiffness_Nm_per_arcmin"] = float(budget.torsional_stiffness[0] * ARCMIN)
+        presets[name]["compliance_share"] = dict(zip(budget.parts, budget.share[0].tolist()))
     presets["note"] = (
         "the paper preset keeps the paper's IMPACT law only to reproduce the paper: its stiffness "
         "k' sqrt(w) from eqs. 5-11 has units N/mm but is read as N/mm^1.5, and it makes the pins "
@@ -220,6 +228,7 @@ def _format_presets(p: dict[str, Any]) -> list[str]:
         ("pin damping", a["damping"], b["damping"]),
         ("main torsional mode", a["main_torsional_mode"], b["main_torsional_mode"]),
         ("bearing life at rated torque and speed", a["bearing_life"], b["bearing_life"]),
+        ("torsional stiffness at rated torque (**)", _stiffness_text(a), _stiffness_text(b)),
     ]
     # Columns as wide as their longest entry, so that no entry runs into the next.
     w0, w1 = (max(len(r[k]) for r in rows) for k in (0, 1))
@@ -227,8 +236,17 @@ def _format_presets(p: dict[str, Any]) -> list[str]:
     lines += [f"  {name:{w0}s}  {x:{w1}s}  {y}" for name, x, y in rows]
     lines.append("  (*) 4 T_c / (zp rc') with T_c = T_out / 2: the largest pin force of the classical load sharing "
                  "(rigid pins, linear law; Malhotra & Parameswaran 1983)")
+    lines.append("  (**) tangent dT/d twist at crank angle 0, input held, and where the compliance comes from "
+                 "(rvdyn.analysis.compliance_budget)")
     lines.append(f"  ({p['note']})")
     return lines
+
+
+def _stiffness_text(preset: dict[str, Any]) -> str:
+    """``"12783 N m/arcmin: crank bearings 47 %, ..."``, largest share first."""
+    shares = sorted(preset["compliance_share"].items(), key=lambda kv: -kv[1])
+    return (f"{preset['torsional_stiffness_Nm_per_arcmin']:.0f} N m/arcmin: "
+            + ", ".join(f"{part} {100 * share:.0f} %" for part, share in shares))
 
 
 def _format_info(d: dict[str, Any]) -> str:
