@@ -391,6 +391,22 @@ def test_ltca_bearing_life(speed, za, zb):
             speed=speed, crank_layout=rvdyn.CrankLayout(bearings=(za, zb), discs=(-0.02, 0.02), planet=-0.09))))
 
 
+_BUDGET_SCENES = {"paper": rvdyn.Scene.paper("rated"), "physical": rvdyn.Scene.physical("rated")}
+
+
+@SETTINGS
+@given(st.sampled_from(["paper", "physical"]),
+       st.one_of(st.none(), any_real, st.floats(-5e4, 5e4), st.lists(any_real, min_size=0, max_size=3)),
+       any_real)
+def test_compliance_budget(preset, torque, crank_angle):
+    out = check("compliance_budget", lambda: (lambda b: (b.compliance, b.share, b.torsional_stiffness,
+                                                         b.split_error, b.table()))(
+        rvdyn.analysis.compliance_budget(_BUDGET_SCENES[preset], torque, crank_angle)))
+    if out is not None:
+        np.testing.assert_allclose(out[1].sum(axis=1), 1.0, atol=1e-8)
+        assert np.all(out[2] > 0)
+
+
 def _unloaded_is_safe(safety: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
     """s0 is inf exactly where a bearing carries nothing (a layout that puts every load on the
     other bearing); 0 stands for it in the finiteness check."""
