@@ -147,8 +147,28 @@ def test_the_budget_predicts_a_design_change(bearing: str, tolerance: float) -> 
     c = 1.0 / b.torsional_stiffness[0]
     name = bearing.replace("_", " ") + "s"
     predicted = -b.compliance[0, b.parts.index(name)] * (1.0 - 1.25 ** -0.8)
+    assert 1.0 / b.predict({name: 1.25 ** 0.8})[0] - c == pytest.approx(predicted, rel=1e-12)
     key = f"joints.{bearing}.rollers.length"
     longer = sc.replace(**{key: 1.25 * sc[key]})
     actual = 1.0 / compliance_budget(longer).torsional_stiffness[0] - c
     assert actual == pytest.approx(predicted, rel=tolerance)
     assert -0.1 * c < actual < -0.04 * c
+
+
+def test_predict_is_the_series_rule_and_checks_its_input() -> None:
+    b = compliance_budget(rvdyn.Scene.physical("rated"), [0.5 * RATED, RATED])
+    c = 1.0 / b.torsional_stiffness
+    g = b.grouped()
+    pins, crank = g.compliance[:, 0], g.compliance[:, g.parts.index("crank bearings")]
+    want = 1.0 / (c - pins * (1 - 1 / 2.0) - crank * (1 - 1 / 1.5))
+    np.testing.assert_allclose(b.predict({"pin contacts": 2.0, "crank bearings": 1.5}), want, rtol=1e-14)
+    # One disc's pins alone; a factor of 1 changes nothing; rigid parts leave the others.
+    one = b.predict({"pin contacts disc 0": 1e12})
+    np.testing.assert_allclose(one, 1.0 / (c - b.compliance[:, 0] * (1 - 1e-12)), rtol=1e-14)
+    np.testing.assert_allclose(b.predict({"eccentric bearings": 1.0}), b.torsional_stiffness, rtol=1e-15)
+    for bad, message in [({}, "non-empty"), ([1.0], "dict"), ({"gears": 2.0}, "no part 'gears'"),
+                         ({"crank bearings": 0.0}, r"\[1e-12, 1e12\]"), ({"crank bearings": math.nan}, "finite"),
+                         ({"crank bearings": "x"}, "number"),
+                         ({"pin contacts": 2.0, "pin contacts disc 1": 2.0}, "not both")]:
+        with pytest.raises(ParameterError, match=message):
+            b.predict(bad)  # type: ignore[arg-type]
