@@ -172,3 +172,45 @@ def test_predict_is_the_series_rule_and_checks_its_input() -> None:
                          ({"pin contacts": 2.0, "pin contacts disc 1": 2.0}, "not both")]:
         with pytest.raises(ParameterError, match=message):
             b.predict(bad)  # type: ignore[arg-type]
+
+
+LAYOUT = {"bearings": [-0.06, 0.06], "discs": [-0.02, 0.02], "planet": -0.09}
+
+
+def test_crank_bending_is_a_part_of_the_budget_and_behaves_as_one() -> None:
+    """The physical preset with 45 mm crankshafts between bearings 120 mm apart (docs/model.md,
+    "Crankshaft bending"): the bending is a part of the budget; a shaft 10 times thicker (1e4
+    times stiffer) removes it (within 2e-3 of the compliance, as the other families); and a
+    50 mm shaft, (50/45)^4 times stiffer, is predicted by ``predict`` within 2 % of the change."""
+    sc = rvdyn.Scene.physical("rated").replace(crank_layout=LAYOUT, crank_shaft={"diameter": 0.045})
+    b = compliance_budget(sc)
+    assert b.parts[-1] == "crank bending"
+    c = 1.0 / b.torsional_stiffness[0]
+    part = b.compliance[0, -1]
+    assert part > 0.2 * c
+    thick = compliance_budget(sc.replace(**{"crank_shaft.diameter": 0.45}))
+    assert c - 1.0 / thick.torsional_stiffness[0] == pytest.approx(part, abs=2e-3 * c)
+    predicted = b.predict({"crank bending": (0.05 / 0.045) ** 4})[0]
+    actual = compliance_budget(sc.replace(**{"crank_shaft.diameter": 0.05})).torsional_stiffness[0]
+    assert 1.0 / actual - c == pytest.approx(1.0 / predicted - c, rel=0.02)
+    # Without the shaft the cranks are rigid: the budget of the preset.
+    rigid = compliance_budget(rvdyn.Scene.physical("rated"))
+    assert "crank bending" not in rigid.parts and rigid.torsional_stiffness[0] > b.torsional_stiffness[0]
+
+
+def test_a_scene_with_bending_cranks_is_refused_by_the_dynamic_model_and_the_modes() -> None:
+    sc = rvdyn.Scene.physical("rated").replace(crank_layout=LAYOUT, crank_shaft={"diameter": 0.045})
+    for call in (lambda: rvdyn.simulate(sc, 0.001), lambda: rvdyn.modes(sc)):
+        with pytest.raises(rvdyn.SceneError, match="quasi-static analyses only.*remove crank_shaft"):
+            call()
+    # The scene's other numbers are still there (the dynamic model's degrees of freedom).
+    assert sc.model_info()["dof"] == rvdyn.Scene.physical("rated").model_info()["dof"]
+    with pytest.raises(rvdyn.SceneError, match="needs crank_layout"):
+        rvdyn.Scene.physical("rated").replace(crank_shaft={"diameter": 0.045})
+    with pytest.raises(rvdyn.SceneError, match="compliant joints"):
+        rvdyn.Scene.paper("rated").replace(crank_layout=LAYOUT, crank_shaft={"diameter": 0.045})
+    with pytest.raises(rvdyn.SceneError, match=r"crank_shaft: diameter must be in \(0, 1\] m"):
+        rvdyn.Scene.physical("rated").replace(crank_layout=LAYOUT, crank_shaft={"diameter": 45.0})
+    with pytest.raises(rvdyn.SceneError, match="bearing's plane"):
+        rvdyn.Scene.physical("rated").replace(crank_layout={**LAYOUT, "discs": [-0.06, 0.02]},
+                                              crank_shaft={"diameter": 0.045})

@@ -1277,3 +1277,69 @@ fn second_start_is_taken_when_the_first_lands_beyond_the_load() {
     assert_eq!(a.1, b.1);
     assert!(apart(&a.0, &b.0) < 1e-15);
 }
+
+/// One disc per crank: the beam's deflection at the disc is `C11 F` along the eccentric
+/// bearing's force, in series with the (linear, clearance-free) bearing, so a bending crank is
+/// the same reducer as a rigid one with the eccentric bearing's stiffness `1 / (1/k + C11)`
+/// (`C11` the closed form of beam theory, `bearing::crank_beam`). The two scenes are solved
+/// separately; equal to Newton's tolerance (1e-12 of the load): asserted 1e-9 of the twist and
+/// of the peak pin force, and the bending visibly softer than the rigid crank (over 5 %).
+#[test]
+fn bending_of_a_one_disc_crank_is_a_softer_eccentric_bearing() {
+    use crate::bearing::{CrankLayout, CrankShaft};
+    let mut bent = Scene::paper("rated").unwrap();
+    bent.discs.truncate(1);
+    bent.joints = default_joints();
+    let layout = CrankLayout {
+        bearings: [-0.06, 0.06],
+        discs: vec![0.01],
+        planet: -0.09,
+        roller_length: None,
+    };
+    let shaft = CrankShaft {
+        diameter: 0.04,
+        modulus: 2.06e11,
+    };
+    let c11 = shaft.flexibility(&layout).unwrap()[0];
+    bent.crank_layout = Some(layout);
+    bent.crank_shaft = Some(shaft);
+    let mut series = bent.clone();
+    series.crank_shaft = None;
+    let rigid = series.clone();
+    if let Joints::Compliant {
+        eccentric_bearing, ..
+    } = &mut series.joints
+    {
+        eccentric_bearing.stiffness = 1.0 / (1.0 / eccentric_bearing.stiffness + c11);
+    }
+    let torque = rated();
+    let (mut a, mut b, mut r) = (
+        Ltca::new(&bent).unwrap(),
+        Ltca::new(&series).unwrap(),
+        Ltca::new(&rigid).unwrap(),
+    );
+    for psi in [0.0, 0.4, 1.7] {
+        let (pa, pb, pr) = (
+            a.solve(torque, psi).unwrap(),
+            b.solve(torque, psi).unwrap(),
+            r.solve(torque, psi).unwrap(),
+        );
+        let twist = |p: &LtcaPoint| -(p.output_angle + psi / 23.0);
+        assert!(
+            (twist(&pa) - twist(&pb)).abs() < 1e-9 * twist(&pb).abs(),
+            "{} {}",
+            twist(&pa),
+            twist(&pb)
+        );
+        let peak = pb.peak_pin_force();
+        for (fa, fb) in pa.pins[0].iter().zip(&pb.pins[0]) {
+            assert!((fa.force - fb.force).abs() < 1e-9 * peak);
+        }
+        assert!(
+            twist(&pa) > 1.05 * twist(&pr),
+            "{} {}",
+            twist(&pa),
+            twist(&pr)
+        );
+    }
+}

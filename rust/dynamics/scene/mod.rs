@@ -899,6 +899,11 @@ pub struct Scene {
     /// lumped crank bearing into its two bearings (default: none, the lumped row only).
     #[serde(default)]
     pub crank_layout: Option<crate::bearing::CrankLayout>,
+    /// The crankshafts' section, for their bending between the bearings in the quasi-static
+    /// analyses (needs `crank_layout` and compliant joints; default: none, rigid cranks). The
+    /// dynamic model and the modes do not model it and refuse such a scene.
+    #[serde(default)]
+    pub crank_shaft: Option<crate::bearing::CrankShaft>,
     /// The input drive.
     pub drive: Drive,
     /// The load on the output.
@@ -926,13 +931,14 @@ fn one_line(e: &dyn std::fmt::Display) -> String {
 impl Scene {
     /// The same reducer with rigid joints, for what only the rigid model's geometry, laws and
     /// masses are wanted from (the LTCA's laws, the mass properties): without the assembly
-    /// errors and the bearing friction that only compliant joints carry, which a rigid scene
-    /// refuses.
+    /// errors, the bearing friction and the crankshaft bending that only compliant joints
+    /// carry, which a rigid scene refuses.
     pub fn rigid_counterpart(&self) -> Scene {
         let mut s = self.clone();
         s.joints = Joints::Rigid;
         s.errors = AssemblyErrors::default();
         s.friction.bearing = None;
+        s.crank_shaft = None;
         s
     }
 

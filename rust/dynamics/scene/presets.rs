@@ -156,6 +156,7 @@ impl Scene {
             gear_errors: GearErrors::default(),
             shafts: Shafts::default(),
             crank_layout: None,
+            crank_shaft: None,
             contact: ContactLaws {
                 pin: ContactLawSpec::paper(),
                 mesh: ContactLawSpec::paper(),

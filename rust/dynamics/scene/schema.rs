@@ -1125,6 +1125,33 @@ pub static FIELDS: &[Field] = &[
         "roller length of each of the two bearings, for their ISO 76/281 ratings (null = half the lumped crank roller length)",
     ),
     f(
+        "crank_shaft",
+        "",
+        "object or null",
+        "-",
+        NULL,
+        "needs crank_layout and compliant joints",
+        "the crankshafts' round section, for their bending between the bearings in the quasi-static analyses (null = rigid cranks; the dynamic model and the modes refuse a scene with it; docs/model.md, Crankshaft bending)",
+    ),
+    f(
+        "crank_shaft.diameter",
+        "",
+        "number",
+        "m",
+        REQ,
+        "(0, 1]; no disc at a bearing's plane",
+        "diameter of the solid shaft between the bearings",
+    ),
+    f(
+        "crank_shaft.modulus",
+        "",
+        "number",
+        "Pa",
+        Some("2.06e11"),
+        "[1e9, 1e12]",
+        "Young's modulus of the shaft (steel)",
+    ),
+    f(
         "shafts",
         "",
         "object",
@@ -1490,6 +1517,7 @@ mod tests {
         v["joints"]["crank_bearing"]["damping"] = json!(1e3);
         v["crank_layout"] = json!({"bearings": [-0.06, 0.06], "discs": [-0.02, 0.02],
             "planet": -0.09, "roller_length": 0.02});
+        v["crank_shaft"] = json!({"diameter": 0.045, "modulus": 2.06e11});
         out.push(v.clone());
         v["contact"]["pin"]["damping"] = json!({"kind": "restitution", "model": "exact",
             "restitution": 0.8, "reference_speed": 0.1});

@@ -242,6 +242,26 @@ impl Scene {
                 ));
             }
         }
+        if let Some(shaft) = &self.crank_shaft {
+            let Some(layout) = &self.crank_layout else {
+                return err(
+                    "crank_shaft needs crank_layout: the planes of the crank bearings and the \
+                     discs along the crank, where the shaft is supported and loaded"
+                        .into(),
+                );
+            };
+            if matches!(self.joints, Joints::Rigid) {
+                return err(
+                    "crank_shaft bends the cranks between their bearings, which needs compliant \
+                     joints (the eccentrics move against the discs): set joints.kind = \
+                     \"compliant\" or remove crank_shaft"
+                        .into(),
+                );
+            }
+            shaft
+                .stiffness(layout)
+                .map_err(|e| RvdynError::Scene(format!("crank_shaft: {e}")))?;
+        }
         self.errors.check(
             self.cranks as usize,
             self.discs.len(),

@@ -361,6 +361,9 @@ impl Statics {
             {
                 for (k, disc) in m.discs.iter().enumerate() {
                     let dk = self.disc_index(k);
+                    // The eccentric's bending deflection from the crank's line (0 without).
+                    let nk = self.bending.as_ref().map(|_| self.node_index(i, k));
+                    let bend = nk.map_or([0.0; 2], |n| [x[n], x[n + 1]]);
                     let ecc = {
                         let c = cos_sin(alpha + disc.phase + self.ecc_phase[i]);
                         let e = self.ecc_radius[i];
@@ -368,8 +371,8 @@ impl Statics {
                     };
                     let arm = rotate(self.disc_cs[k], self.holes[i * nd + k]);
                     let d = [
-                        x[dk] + arm[0] - p[0] - ecc[0],
-                        x[dk + 1] + arm[1] - p[1] - ecc[1],
+                        x[dk] + arm[0] - p[0] - bend[0] - ecc[0],
+                        x[dk + 1] + arm[1] - p[1] - bend[1] - ecc[1],
                     ];
                     let (g, h) = eb.static_tangent(d);
                     let pa = perp(arm);
@@ -382,15 +385,45 @@ impl Statics {
                         (ci + 1, [0.0, -1.0]),
                         (ci + 2, [-pe[0], -pe[1]]),
                     ];
-                    add_bearing(qf, kf, &cols, g, h);
+                    let node_cols: [(usize, [f64; 2]); 2] = nk.map_or([(0, [0.0; 2]); 2], |n| {
+                        [(n, [-1.0, 0.0]), (n + 1, [0.0, -1.0])]
+                    });
+                    let all: [(usize, [f64; 2]); 8] = [
+                        cols[0],
+                        cols[1],
+                        cols[2],
+                        cols[3],
+                        cols[4],
+                        cols[5],
+                        node_cols[0],
+                        node_cols[1],
+                    ];
+                    let cols: &[(usize, [f64; 2])] = if nk.is_some() { &all } else { &cols };
+                    add_bearing(qf, kf, cols, g, h);
                     if let Some(c) = cf.as_mut() {
-                        add_bearing_damping(c, &cols, eb.damping_matrix(d));
+                        add_bearing_damping(c, cols, eb.damping_matrix(d));
                     }
                     kf.add(dk + 2, dk + 2, -dot(g, arm));
                     kf.add(ci + 2, ci + 2, dot(g, ecc));
                     if let Some(st) = state.as_deref_mut() {
                         st.eccentric_bearing_force.push([-g[0], -g[1]]);
                         st.bearing_couple -= d[0] * g[1] - d[1] * g[0];
+                    }
+                }
+            }
+        }
+        // Crankshaft bending: V = 1/2 sum_axes u^T K_b u over each crank's eccentric deflections.
+        if let Some(kb) = self.bending.as_ref().filter(|_| on(Family::CrankBending)) {
+            for i in 0..self.cranks {
+                for a in 0..nd {
+                    let na = self.node_index(i, a);
+                    for b in 0..nd {
+                        let nb = self.node_index(i, b);
+                        let kab = kb[a * nd + b];
+                        for axis in 0..2 {
+                            qf[na + axis] -= kab * x[nb + axis];
+                            kf.add(na + axis, nb + axis, kab);
+                        }
                     }
                 }
             }

@@ -58,6 +58,8 @@ pub enum Family {
     CrankBearings,
     /// The eccentric (needle) bearings between the cranks and the discs.
     EccentricBearings,
+    /// The crankshafts' bending between their bearings (`crank_shaft`).
+    CrankBending,
 }
 
 /// How the unknowns map to the full coordinates.
@@ -82,6 +84,10 @@ pub struct Statics {
     pub eccentric_bearing: Option<BearingLaw>,
     /// Law of the crank bearings (`None`: rigid).
     pub crank_bearing: Option<BearingLaw>,
+    /// Bending stiffness of each crankshaft at the discs' planes, row-major `discs x discs`
+    /// \[N/m\] (`crank_shaft`; `None`: rigid cranks). With it, each eccentric's deflection
+    /// from its crank's line is a full coordinate ([`Statics::node_index`]).
+    pub bending: Option<Vec<f64>>,
     /// Number of cranks.
     pub cranks: usize,
     /// The pin law (IMPACT, Palmgren or line contact).
@@ -207,6 +213,19 @@ impl Statics {
         });
         let has_mesh = model.mesh.is_some();
         let rp = scene.cycloid.pin_circle_radius;
+        let bending = match (&scene.crank_shaft, &scene.crank_layout, kind) {
+            (Some(shaft), Some(layout), Kind::Compliant) => Some(
+                shaft
+                    .stiffness(layout)
+                    .map_err(|e| RvdynError::Scene(format!("crank_shaft: {e}")))?,
+            ),
+            (Some(_), _, _) => {
+                return Err(RvdynError::Scene(
+                    "crank_shaft needs crank_layout and compliant joints".into(),
+                ));
+            }
+            _ => None,
+        };
         let (unknowns, scale) = match kind {
             Kind::Rigid => {
                 if has_mesh {
@@ -234,6 +253,12 @@ impl Statics {
                     u.extend([dk, dk + 1, dk + 2]);
                     s.extend([1.0, 1.0, rp]);
                 }
+                if bending.is_some() {
+                    // Each eccentric's bending deflection (x, y) per crank and disc.
+                    let first = 2 + 3 * n + 3 * nd;
+                    u.extend(first..first + 2 * n * nd);
+                    s.extend(std::iter::repeat_n(1.0, 2 * n * nd));
+                }
                 (u, s)
             }
         };
@@ -260,6 +285,7 @@ impl Statics {
             kind,
             eccentric_bearing,
             crank_bearing,
+            bending,
             cranks: n,
             pin_law,
             mesh_law,
@@ -343,6 +369,9 @@ impl Statics {
             if self.crank_bearing.is_some() {
                 families.push(("crank bearings".into(), Family::CrankBearings));
             }
+            if self.bending.is_some() {
+                families.push(("crank bending".into(), Family::CrankBending));
+            }
         }
         families
     }
@@ -354,7 +383,21 @@ impl Statics {
 
     /// Number of full coordinates.
     pub fn full_len(&self) -> usize {
-        2 + 3 * self.cranks + 3 * self.model.discs.len()
+        let nd = self.model.discs.len();
+        let nodes = if self.bending.is_some() {
+            2 * self.cranks * nd
+        } else {
+            0
+        };
+        2 + 3 * self.cranks + 3 * nd + nodes
+    }
+
+    /// Index of the `x` deflection of crank `i`'s eccentric for disc `k` from the crank's line
+    /// (bending; `y` follows) in the full coordinates. Only with [`Statics::bending`].
+    #[inline]
+    pub fn node_index(&self, i: usize, k: usize) -> usize {
+        let nd = self.model.discs.len();
+        2 + 3 * self.cranks + 3 * nd + 2 * (i * nd + k)
     }
 
     /// Index of disc `k`'s `X` in the full coordinates.

@@ -156,6 +156,15 @@ impl CompliantModel {
     /// Build the model of a validated scene with `joints = Compliant {..}`.
     pub fn new(scene: &Scene) -> Result<Self> {
         scene.validate()?;
+        if scene.crank_shaft.is_some() {
+            return Err(RvdynError::Scene(
+                "crank_shaft (the crankshafts' bending) is modelled by the quasi-static analyses \
+                 only (rvdyn.ltca, transmission_error, torque_twist, compliance_budget, tolerance \
+                 studies with the LTCA kernel); the dynamic model and the modes treat the cranks \
+                 as rigid: remove crank_shaft for this scene (scene.replace(crank_shaft=None))"
+                    .into(),
+            ));
+        }
         let Joints::Compliant {
             eccentric_bearing,
             crank_bearing,

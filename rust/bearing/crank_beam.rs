@@ -1,0 +1,261 @@
+//! Bending of a crankshaft between its two bearings: the flexibility of the eccentrics (the
+//! disc centre planes) under radial loads, for the quasi-static analyses (docs/model.md,
+//! "Crankshaft bending").
+//!
+//! The shaft is an Euler-Bernoulli beam of one round section (`E I`, `I = pi d^4 / 64`), simply
+//! supported at the two bearings' mid-planes (their radial compliance is the lumped crank
+//! bearing's), loaded at the discs' mid-planes. Its deflection is taken relative to the line
+//! through the two supports: the planar models' crank centre stands for that line. A beam of
+//! cubic Hermite elements with nodes at the supports and at the loads is exact for point loads
+//! at nodes (the deflection between nodes is a cubic; Cook, Malkus, Plesha & Witt 2002, the
+//! beam element), so the flexibility below is the closed form of beam theory for any layout,
+//! overhangs included.
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use super::CrankLayout;
+use crate::error::{Result, RvdynError};
+
+/// Young's modulus of steel \[Pa\], the default of [`CrankShaft::modulus`].
+pub const STEEL_MODULUS: f64 = 2.06e11;
+
+fn steel() -> f64 {
+    STEEL_MODULUS
+}
+
+/// A crankshaft's section for its bending (a scene's `crank_shaft`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrankShaft {
+    /// Diameter of the solid round shaft between the bearings \[m\].
+    pub diameter: f64,
+    /// Young's modulus \[Pa\] (default steel, 206 GPa).
+    #[serde(default = "steel")]
+    pub modulus: f64,
+}
+
+impl CrankShaft {
+    /// Check the values. Errors (`Parameter`): a diameter outside (0, 1] m or a modulus outside
+    /// [1e9, 1e12] Pa (a value in mm or GPa).
+    pub fn validate(&self) -> Result<()> {
+        if !(self.diameter > 0.0 && self.diameter <= 1.0) {
+            return Err(RvdynError::Parameter(format!(
+                "diameter must be in (0, 1] m, got {} (a value in mm?)",
+                self.diameter
+            )));
+        }
+        if !(1e9..=1e12).contains(&self.modulus) {
+            return Err(RvdynError::Parameter(format!(
+                "modulus must be in [1e9, 1e12] Pa (steel 2.06e11), got {} (a value in GPa?)",
+                self.modulus
+            )));
+        }
+        Ok(())
+    }
+
+    /// Bending stiffness `E I` [N m^2] of the round section.
+    pub fn bending_stiffness(&self) -> f64 {
+        self.modulus * std::f64::consts::PI * self.diameter.powi(4) / 64.0
+    }
+
+    /// Flexibility of the eccentrics: `C[k][l]` [m/N] is the deflection at disc `k`'s plane
+    /// under a unit radial force at disc `l`'s, relative to the line through the bearings
+    /// (symmetric, positive definite). Row-major, `discs x discs`.
+    ///
+    /// Errors (`Parameter`): a disc at a bearing's plane (no deflection there to model; move it
+    /// by a fraction of a millimetre or leave the shaft out).
+    ///
+    /// ```
+    /// use rvdyn::bearing::{CrankLayout, CrankShaft};
+    /// let layout = CrankLayout {
+    ///     bearings: [0.0, 0.1], discs: vec![0.05], planet: -0.03, roller_length: None,
+    /// };
+    /// let shaft = CrankShaft { diameter: 0.04, modulus: 2.06e11 };
+    /// let c = shaft.flexibility(&layout).unwrap();
+    /// // Mid-span: L^3 / (48 E I).
+    /// let want = 0.1f64.powi(3) / (48.0 * shaft.bending_stiffness());
+    /// assert!((c[0] / want - 1.0).abs() < 1e-12);
+    /// ```
+    pub fn flexibility(&self, layout: &CrankLayout) -> Result<Vec<f64>> {
+        self.validate()?;
+        layout.validate()?;
+        let [za, zb] = layout.bearings;
+        let span = (zb - za).abs();
+        for (k, &z) in layout.discs.iter().enumerate() {
+            if (z - za).abs().min((z - zb).abs()) < 1e-6 * span {
+                return Err(RvdynError::Parameter(format!(
+                    "disc {k} sits at a crank bearing's plane ({z} m): the shaft does not bend \
+                     there; move the disc off the bearing or leave crank_shaft out"
+                )));
+            }
+        }
+        // Nodes: the bearings and the discs, sorted and merged.
+        let mut z: Vec<f64> = layout
+            .bearings
+            .iter()
+            .chain(&layout.discs)
+            .copied()
+            .collect();
+        z.sort_by(f64::total_cmp);
+        z.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * span);
+        let node = |x: f64| {
+            z.iter()
+                .position(|&y| (y - x).abs() <= 1e-12 * span)
+                .expect("every position is a node")
+        };
+        let n = z.len();
+        let ei = self.bending_stiffness();
+        // DOFs (w, w') per node.
+        let mut k = DMatrix::<f64>::zeros(2 * n, 2 * n);
+        for e in 0..n - 1 {
+            let l = z[e + 1] - z[e];
+            let c = ei / l.powi(3);
+            let ke = [
+                [12.0, 6.0 * l, -12.0, 6.0 * l],
+                [6.0 * l, 4.0 * l * l, -6.0 * l, 2.0 * l * l],
+                [-12.0, -6.0 * l, 12.0, -6.0 * l],
+                [6.0 * l, 2.0 * l * l, -6.0 * l, 4.0 * l * l],
+            ];
+            for (a, row) in ke.iter().enumerate() {
+                for (b, v) in row.iter().enumerate() {
+                    k[(2 * e + a, 2 * e + b)] += c * v;
+                }
+            }
+        }
+        // Supports: w = 0 at both bearings (rows and columns replaced by the identity).
+        let supports = [2 * node(za), 2 * node(zb)];
+        for &s in &supports {
+            for j in 0..2 * n {
+                k[(s, j)] = 0.0;
+                k[(j, s)] = 0.0;
+            }
+            k[(s, s)] = 1.0;
+        }
+        let lu = k.lu();
+        let nd = layout.discs.len();
+        let mut c = vec![0.0; nd * nd];
+        for (l, &zl) in layout.discs.iter().enumerate() {
+            let mut f = DVector::<f64>::zeros(2 * n);
+            f[2 * node(zl)] = 1.0;
+            let w = lu.solve(&f).ok_or_else(|| {
+                RvdynError::Parameter("the crankshaft's beam model is singular".into())
+            })?;
+            for (kk, &zk) in layout.discs.iter().enumerate() {
+                c[kk * nd + l] = w[2 * node(zk)];
+            }
+        }
+        Ok(c)
+    }
+
+    /// Stiffness of the eccentrics against bending, the inverse of
+    /// [`flexibility`](Self::flexibility) [N/m], row-major `discs x discs`. Errors as
+    /// `flexibility`.
+    pub fn stiffness(&self, layout: &CrankLayout) -> Result<Vec<f64>> {
+        let c = self.flexibility(layout)?;
+        let nd = layout.discs.len();
+        let m = DMatrix::from_row_slice(nd, nd, &c);
+        let inv = m.cholesky().map(|ch| ch.inverse()).ok_or_else(|| {
+            RvdynError::Parameter(
+                "two discs at the same plane of the crank: their bending cannot be told apart"
+                    .into(),
+            )
+        })?;
+        Ok((0..nd)
+            .flat_map(|i| (0..nd).map(move |j| (i, j)))
+            .map(|(i, j)| inv[(i, j)])
+            .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn layout(bearings: [f64; 2], discs: Vec<f64>) -> CrankLayout {
+        CrankLayout {
+            bearings,
+            discs,
+            planet: -0.09,
+            roller_length: None,
+        }
+    }
+
+    /// Simply supported span `L`, load `P` at `a` from the left support (`b = L - a`): the
+    /// deflection at `x <= a` is `P b x (L^2 - b^2 - x^2) / (6 E I L)` (Young & Budynas 2002,
+    /// Roark's Formulas for Stress and Strain, table 8.1, simply supported ends); symmetric by
+    /// Maxwell's reciprocity. Overhang: a load at `c` beyond
+    /// the right support deflects its own point by `P c^2 (L + c) / (3 E I)`.
+    #[test]
+    fn flexibility_is_the_closed_form_of_beam_theory() {
+        let s = CrankShaft {
+            diameter: 0.04,
+            modulus: STEEL_MODULUS,
+        };
+        let ei = s.bending_stiffness();
+        let l = 0.12;
+        let (x1, x2) = (0.04, 0.09);
+        let c = s.flexibility(&layout([0.0, l], vec![x1, x2])).unwrap();
+        let def = |x: f64, a: f64| {
+            let b = l - a;
+            if x <= a {
+                b * x * (l * l - b * b - x * x) / (6.0 * ei * l)
+            } else {
+                let (x, b) = (l - x, a);
+                b * x * (l * l - b * b - x * x) / (6.0 * ei * l)
+            }
+        };
+        let want = [def(x1, x1), def(x1, x2), def(x2, x1), def(x2, x2)];
+        for (g, w) in c.iter().zip(want) {
+            assert!((g / w - 1.0).abs() < 1e-12, "{g:e} {w:e}");
+        }
+        // Reversed axis and origin: the same.
+        let r = s
+            .flexibility(&layout([0.3, 0.3 - l], vec![0.3 - x1, 0.3 - x2]))
+            .unwrap();
+        for (a, b) in c.iter().zip(&r) {
+            assert!((a / b - 1.0).abs() < 1e-12);
+        }
+        let over = 0.03;
+        let o = s.flexibility(&layout([0.0, l], vec![l + over])).unwrap();
+        let want = over * over * (l + over) / (3.0 * ei);
+        assert!((o[0] / want - 1.0).abs() < 1e-12, "{:e} {want:e}", o[0]);
+        // The stiffness is the inverse.
+        let k = s.stiffness(&layout([0.0, l], vec![x1, x2])).unwrap();
+        for i in 0..2 {
+            for j in 0..2 {
+                let e: f64 = (0..2).map(|m| k[i * 2 + m] * c[m * 2 + j]).sum();
+                assert!((e - f64::from(u8::from(i == j))).abs() < 1e-12, "{e}");
+            }
+        }
+    }
+
+    #[test]
+    fn bad_sections_and_discs_at_a_bearing_are_named() {
+        let l = layout([0.0, 0.1], vec![0.05]);
+        for (d, e) in [
+            (0.0, STEEL_MODULUS),
+            (40.0, STEEL_MODULUS),
+            (0.04, 206.0),
+            (f64::NAN, 2e11),
+        ] {
+            let err = CrankShaft {
+                diameter: d,
+                modulus: e,
+            }
+            .flexibility(&l)
+            .unwrap_err();
+            assert!(matches!(err, RvdynError::Parameter(_)), "{err}");
+        }
+        let s = CrankShaft {
+            diameter: 0.04,
+            modulus: STEEL_MODULUS,
+        };
+        let err = s.flexibility(&layout([0.0, 0.1], vec![0.1])).unwrap_err();
+        assert!(err.to_string().contains("bearing's plane"), "{err}");
+        let err = s
+            .stiffness(&layout([0.0, 0.1], vec![0.05, 0.05]))
+            .unwrap_err();
+        assert!(err.to_string().contains("same plane"), "{err}");
+    }
+}
