@@ -336,7 +336,17 @@ fn pack<'py>(py: Python<'py>, pts: &[LtcaPoint]) -> PyResult<Bound<'py, PyDict>>
     } else {
         vec![n, 0, nd, 2]
     };
-    d.set_item("eccentric_bearing_force", f64_array(py, eb, shape)?)?;
+    d.set_item("eccentric_bearing_force", f64_array(py, eb, shape.clone())?)?;
+    let bent: Vec<f64> = pts
+        .iter()
+        .flat_map(|p| p.crank_deflection.iter().flatten().copied())
+        .collect();
+    let shape = if bent.is_empty() {
+        vec![n, 0, nd, 2]
+    } else {
+        shape
+    };
+    d.set_item("crank_deflection", f64_array(py, bent, shape)?)?;
     Ok(d)
 }
 

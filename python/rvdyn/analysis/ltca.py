@@ -74,7 +74,9 @@ class LtcaResult:
     ``disc_displacement`` (n, discs, 2) [m], fixed frame; ``mesh_force`` (n, cranks) [N];
     ``crank_bearing_force`` (n, cranks, 2) and ``eccentric_bearing_force`` (n, cranks, discs, 2)
     [N], fixed frame as in a dynamic run (rotate by ``-disc_angle`` to apply them to a disc mesh
-    with the pin loads; empty for rigid joints); ``torque_balance``, ``residual`` (n,) relative
+    with the pin loads; empty for rigid joints); ``crank_deflection`` (n, cranks, discs, 2) [m],
+    fixed frame: each eccentric's bending deflection from its crank's line (a scene with
+    ``crank_shaft``; empty otherwise); ``torque_balance``, ``residual`` (n,) relative
     (to the torque and the load scale; near the smallest torque an equilibrium resolves they are
     set by the round-off of the contact forces, about 1e-5 at 1e-3 N m on the paper scene);
     ``iterations`` (n,); ``torsional_stiffness`` (n,) [N m/rad]. ``scene``: the analysed scene

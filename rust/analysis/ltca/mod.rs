@@ -87,6 +87,9 @@ pub struct LtcaPoint {
     pub crank_bearing_force: Vec<[f64; 2]>,
     /// Eccentric bearing force on each disc, `[crank * discs + disc]` \[N\] (compliant joints).
     pub eccentric_bearing_force: Vec<[f64; 2]>,
+    /// Bending deflection of each crank's eccentric from the crank's line, `[crank * discs +
+    /// disc]` \[m\], fixed frame (bending cranks, `crank_shaft`; else empty).
+    pub crank_deflection: Vec<[f64; 2]>,
     /// Moment balance of the whole reducer about its axis (input + load + pin reactions),
     /// relative to the torque (absolute, N m, at zero torque). Near the smallest torque an
     /// equilibrium resolves it is set by the round-off of the contact forces (about 1e-5 at 1e-3
@@ -853,6 +856,17 @@ impl Ltca {
             mesh_force: cs.mesh_force.clone(),
             crank_bearing_force: cs.crank_bearing_force.clone(),
             eccentric_bearing_force: cs.eccentric_bearing_force.clone(),
+            crank_deflection: if st.bending.is_some() {
+                (0..st.cranks)
+                    .flat_map(|i| (0..m.discs.len()).map(move |k| (i, k)))
+                    .map(|(i, k)| {
+                        let n = st.node_index(i, k);
+                        [x[n], x[n + 1]]
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            },
             torque_balance: balance,
             residual: rep.residual,
             iterations: rep.iterations,
