@@ -141,6 +141,9 @@ def run(args: argparse.Namespace) -> int:
                            "reverse": float(te.reverse.mean()) / ARCMIN},
         **loop.summary(),
         "compliance_budget": budget.summary(),
+        # Bending cranks (crank_shaft): the largest nominal bending stress over the period [Pa].
+        "crank_bending_stress_max_Pa": (float(res.crank_bending_stress().max())
+                                        if scene["crank_shaft"] else None),
         "bearing_static_safety": bearings,
         "bearing_life": lives,
         # The layout that split the crank bearing into crank_a and crank_b [m], if any.
@@ -173,6 +176,9 @@ def run(args: argparse.Namespace) -> int:
         f"- compliance budget at {res.torque:.1f} N m (tangent stiffness "
         f"{summary['compliance_budget']['tangent_stiffness_Nm_per_arcmin']:.1f} N m/arcmin at crank angle 0): "
         f"{budget.where()} (compliance_budget.png: the shares from 5 % of the torque up)",
+        *([f"- crankshafts ({scene['crank_shaft.diameter'] * 1e3:g} mm, bending between their bearings): "
+           f"largest nominal bending stress {summary['crank_bending_stress_max_Pa'] / 1e6:.0f} MPa "
+           "(32 M / (pi d^3), no notch factor)"] if scene["crank_shaft"] else []),
         *([("- bearings at this torque (ISO 76 static safety s0 = C0r / peak load): " + "; ".join(
             f"{name.replace('_', ' ')} peak {b['peak_load'] / 1e3:.1f} kN, C0r {b['static_rating'] / 1e3:.1f} kN, "
             f"s0 {b['static_safety']:.2f}" for name, b in bearings.items())
