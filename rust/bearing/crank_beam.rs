@@ -99,10 +99,12 @@ impl CrankShaft {
             .collect();
         z.sort_by(f64::total_cmp);
         z.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * span);
+        // Every position is a node (the list was built from them); the nearest one, without a
+        // tolerance to miss.
         let node = |x: f64| {
-            z.iter()
-                .position(|&y| (y - x).abs() <= 1e-12 * span)
-                .expect("every position is a node")
+            (0..z.len())
+                .min_by(|&a, &b| (z[a] - x).abs().total_cmp(&(z[b] - x).abs()))
+                .unwrap_or(0)
         };
         let n = z.len();
         let ei = self.bending_stiffness();
