@@ -98,3 +98,23 @@ def test_analyze_reports_the_bending_cranks(tmp_path: Path) -> None:
     assert summary["crank_bending_stress_max_Pa"] == pytest.approx(float(want.max()), rel=1e-9)
     assert "crank bending" in summary["compliance_budget"]["share"]
     assert "largest nominal bending stress" in (out / "summary.md").read_text()
+
+
+def test_the_ltca_kernel_gives_the_bending_metrics() -> None:
+    """``LtcaKernel(crank_bending=True)``: the largest stress and deflection of the LTCA over
+    the kernel's crank angles (two per tooth-mesh cycle of the physical preset's ISO mesh), with
+    their units; a scene without ``crank_shaft`` is a ParameterError."""
+    scene = rvdyn.Scene.physical("rated").replace(crank_layout=LAYOUT, crank_shaft={"diameter": 0.045})
+    kernel = rvdyn.study.LtcaKernel(crank_bending=True, window=False)
+    assert kernel.metrics[-2:] == tuple(rvdyn.study.LTCA_CRANK_METRICS)
+    got = kernel(scene)
+    n = rvdyn.analysis.tooth_mesh_angles(scene)
+    period = rvdyn.ltca(scene, crank_angles=[0.0]).mesh_period
+    res = rvdyn.ltca(scene, crank_angles=period * np.arange(n) / n)
+    assert got["crank_bending_stress_max"] == float(res.crank_bending_stress().max())
+    assert got["crank_deflection_max"] == float(np.linalg.norm(res.crank_deflection, axis=-1).max())
+    assert rvdyn.study.kernels.metric_units(kernel)["crank_bending_stress_max"] == "Pa"
+    with pytest.raises(rvdyn.ParameterError, match="crank_bending=True needs a scene with crank_shaft"):
+        kernel(rvdyn.Scene.physical("rated"))
+    with pytest.raises(rvdyn.ParameterError, match="crank_bending must be True or False"):
+        rvdyn.study.LtcaKernel(crank_bending="yes")  # type: ignore[arg-type]

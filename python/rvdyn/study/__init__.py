@@ -27,8 +27,8 @@ import types
 from typing import Any
 
 from .driver import run
-from .kernels import (DYNAMIC_METRICS, KERNELS, LTCA_BEARING_METRICS, LTCA_METRICS, DynamicKernel, FunctionKernel,
-                      LtcaKernel, get_kernel, register_kernel)
+from .kernels import (DYNAMIC_METRICS, KERNELS, LTCA_BEARING_METRICS, LTCA_CRANK_METRICS, LTCA_METRICS, DynamicKernel,
+                      FunctionKernel, LtcaKernel, get_kernel, register_kernel)
 from .plots import plot_histogram, plot_sensitivity
 from .runners import RUNNER_FAILED, RunnerError, RunnerFailureWarning, ThreadRunner, evaluate, evaluate_batch
 from .sampling import LatinHypercube, MonteCarlo, design
@@ -39,6 +39,7 @@ from .storage import read
 __all__ = [
     "run", "read", "Tolerance", "Correlation", "Criterion", "MonteCarlo", "LatinHypercube", "design", "expand",
     "DynamicKernel", "LtcaKernel", "FunctionKernel", "KERNELS", "DYNAMIC_METRICS", "LTCA_METRICS", "LTCA_BEARING_METRICS",
+    "LTCA_CRANK_METRICS",
     "register_kernel",
     "get_kernel",
     "RunnerError", "RunnerFailureWarning", "RUNNER_FAILED", "ThreadRunner", "evaluate", "evaluate_batch",

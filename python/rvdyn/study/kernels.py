@@ -23,7 +23,7 @@ from ..errors import ParameterError
 from ..scene import Scene
 
 __all__ = ["DynamicKernel", "LtcaKernel", "FunctionKernel", "KERNELS", "register_kernel", "get_kernel",
-           "DYNAMIC_METRICS", "LTCA_METRICS", "LTCA_BEARING_METRICS"]
+           "DYNAMIC_METRICS", "LTCA_METRICS", "LTCA_BEARING_METRICS", "LTCA_CRANK_METRICS"]
 
 #: Metrics of :class:`DynamicKernel`, evaluated on the window [t_start, t_end] (SI units).
 DYNAMIC_METRICS: dict[str, str] = {
@@ -109,7 +109,8 @@ def metric_units(kernel: Any) -> dict[str, str]:
     units = getattr(kernel, "units", None)
     if isinstance(units, Mapping):
         return {str(k): str(v) for k, v in units.items()}
-    docs = {DynamicKernel: DYNAMIC_METRICS, LtcaKernel: {**LTCA_METRICS, **LTCA_BEARING_METRICS}}.get(type(kernel), {})
+    docs = {DynamicKernel: DYNAMIC_METRICS,
+            LtcaKernel: {**LTCA_METRICS, **LTCA_BEARING_METRICS, **LTCA_CRANK_METRICS}}.get(type(kernel), {})
     out: dict[str, str] = {}
     metrics = set(getattr(kernel, "metrics", None) or docs)
     for name, text in docs.items():
@@ -163,6 +164,15 @@ LTCA_BEARING_METRICS: dict[str, str] = {
 }
 
 
+#: Metrics :class:`LtcaKernel` adds with ``crank_bending=True`` (a scene with ``crank_shaft``;
+#: :meth:`rvdyn.analysis.LtcaResult.crank_bending_stress` and ``crank_deflection`` over one mesh
+#: period at +torque; docs/model.md, "Crankshaft bending").
+LTCA_CRANK_METRICS: dict[str, str] = {
+    "crank_bending_stress_max": "largest nominal bending stress 32 M / (pi d^3) in any crankshaft [Pa]",
+    "crank_deflection_max": "largest bending deflection of an eccentric from its crank's line [m]",
+}
+
+
 @dataclass(frozen=True)
 class LtcaKernel:
     """Loaded tooth contact analysis reduced to :data:`LTCA_METRICS`.
@@ -178,8 +188,10 @@ class LtcaKernel:
     without pin errors, twelve times the cost) or, with ``window=False``, over one mesh period.
     bearings: also the bearings' life and static safety (:data:`LTCA_BEARING_METRICS`, from an
     LTCA at ``points`` crank angles over one mesh period; needs roller bearings and a constant
-    drive speed). A sample whose analysis fails (no equilibrium, invalid geometry) raises its
-    error, which the study records in the sample's row."""
+    drive speed). crank_bending: also the crankshafts' bending stress and deflection
+    (:data:`LTCA_CRANK_METRICS`, from the same LTCA; needs a scene with ``crank_shaft``). A
+    sample whose analysis fails (no equilibrium, invalid geometry) raises its error, which the
+    study records in the sample's row."""
 
     torque: float | None = None
     points: int = 24
@@ -187,6 +199,7 @@ class LtcaKernel:
     crank_angle: float = 0.0
     window: bool = True
     bearings: bool = False
+    crank_bending: bool = False
     name: str = field(default="ltca", init=False)
 
     def __post_init__(self) -> None:
@@ -203,10 +216,13 @@ class LtcaKernel:
             raise ParameterError(f"ltca kernel: window must be True or False, got {self.window!r}")
         if not isinstance(self.bearings, bool):
             raise ParameterError(f"ltca kernel: bearings must be True or False, got {self.bearings!r}")
+        if not isinstance(self.crank_bending, bool):
+            raise ParameterError(f"ltca kernel: crank_bending must be True or False, got {self.crank_bending!r}")
 
     @property
     def metrics(self) -> tuple[str, ...]:
-        return tuple(LTCA_METRICS) + (tuple(LTCA_BEARING_METRICS) if self.bearings else ())
+        return (tuple(LTCA_METRICS) + (tuple(LTCA_BEARING_METRICS) if self.bearings else ())
+                + (tuple(LTCA_CRANK_METRICS) if self.crank_bending else ()))
 
     def __call__(self, scene: Scene) -> dict[str, float]:
         # The computations of rvdyn.analysis.transmission_error (its loaded part, with the
@@ -218,6 +234,8 @@ class LtcaKernel:
         from ..analysis.ltca import _rated, _scene, _tooth_mesh_angles, _window_periods
 
         sc = _scene(scene)
+        if self.crank_bending and not sc["crank_shaft"]:
+            raise ParameterError("ltca kernel: crank_bending=True needs a scene with crank_shaft (and crank_layout)")
         torque = abs(_rated(sc, self.torque))
         solver = _core.LtcaSolver(sc._compiled, 1e-12)
         period = float(solver.mesh_period)
@@ -235,7 +253,7 @@ class LtcaKernel:
             "torsional_rigidity": float(loop["rigidity"]),
             "lost_motion": float(loop["lost_motion"]),
         }
-        if self.bearings:
+        if self.bearings or self.crank_bending:
             import warnings
 
             from ..analysis.ltca import ltca
@@ -243,9 +261,14 @@ class LtcaKernel:
             angles = period * np.arange(points) / points
             with warnings.catch_warnings():  # s0 below 1 is a metric here, not a warning per sample
                 warnings.simplefilter("ignore", RuntimeWarning)
-                life = ltca(sc, torque, angles).bearing_life()
-            out["bearing_l10_hours_min"] = min(v["l10_hours"] for v in life.values())
-            out["bearing_static_safety_min"] = min(v["static_safety"] for v in life.values())
+                res = ltca(sc, torque, angles)
+                if self.bearings:
+                    life = res.bearing_life()
+                    out["bearing_l10_hours_min"] = min(v["l10_hours"] for v in life.values())
+                    out["bearing_static_safety_min"] = min(v["static_safety"] for v in life.values())
+            if self.crank_bending:
+                out["crank_bending_stress_max"] = float(res.crank_bending_stress().max())
+                out["crank_deflection_max"] = float(np.linalg.norm(res.crank_deflection, axis=-1).max())
         return out
 
 
