@@ -14,10 +14,10 @@ import rvdyn
 LAYOUT = {"bearings": [-0.06, 0.06], "discs": [-0.02, 0.02], "planet": -0.09}
 
 
-def simple_span_flexibility(z: list[float], supports: tuple[float, float], ei: float) -> np.ndarray:
-    """Deflection at ``z[k]`` per unit load at ``z[l]`` of a simply supported span (loads between
-    the supports): ``b x (L^2 - b^2 - x^2) / (6 E I L)`` for ``x <= a`` (Young & Budynas 2002,
-    table 8.1), mirrored for ``x > a``."""
+def simple_span_flexibility(z: list[float], supports: tuple[float, float], ei: float, gas: float) -> np.ndarray:
+    """Deflection at ``z[k]`` per unit load at ``z[l]`` of a simply supported Timoshenko span
+    (loads between the supports): bending ``b x (L^2 - b^2 - x^2) / (6 E I L)`` (Young & Budynas
+    2002, table 8.1) plus shear ``b x / (kappa G A L)`` for ``x <= a``, mirrored for ``x > a``."""
     za, zb = supports
     span = zb - za
     c = np.empty((len(z), len(z)))
@@ -27,7 +27,7 @@ def simple_span_flexibility(z: list[float], supports: tuple[float, float], ei: f
             if x > a:
                 x, a = span - x, span - a
             b = span - a
-            c[k, j] = b * x * (span**2 - b**2 - x**2) / (6.0 * ei * span)
+            c[k, j] = b * x * (span**2 - b**2 - x**2) / (6.0 * ei * span) + b * x / (gas * span)
     return c
 
 
@@ -41,7 +41,9 @@ def test_reported_deflections_are_the_beam_under_the_eccentric_loads() -> None:
     sc = rvdyn.Scene.physical("rated").replace(crank_layout=LAYOUT, crank_shaft={"diameter": d})
     res = rvdyn.ltca(sc, crank_angles=np.linspace(0.0, 1.0, 5))
     ei = 2.06e11 * math.pi * d**4 / 64.0
-    c = simple_span_flexibility([-0.02, 0.02], (-0.06, 0.06), ei)
+    nu = 0.3  # steel, the default; Cowper's shear coefficient of a solid circle
+    gas = 6 * (1 + nu) / (7 + 6 * nu) * 2.06e11 / (2 * (1 + nu)) * math.pi * d**2 / 4
+    c = simple_span_flexibility([-0.02, 0.02], (-0.06, 0.06), ei, gas)
     defl = res.crank_deflection
     assert defl.shape == (5, 3, 2, 2)
     # (angles, cranks, discs, 2): deflection u = C (force on the eccentric) = -C (force on the disc).

@@ -1152,6 +1152,15 @@ pub static FIELDS: &[Field] = &[
         "Young's modulus of the shaft (steel)",
     ),
     f(
+        "crank_shaft.poisson",
+        "",
+        "number",
+        "-",
+        Some("0.3"),
+        "[0, 0.5)",
+        "Poisson's ratio of the shaft (steel), for its shear modulus",
+    ),
+    f(
         "shafts",
         "",
         "object",
@@ -1517,7 +1526,7 @@ mod tests {
         v["joints"]["crank_bearing"]["damping"] = json!(1e3);
         v["crank_layout"] = json!({"bearings": [-0.06, 0.06], "discs": [-0.02, 0.02],
             "planet": -0.09, "roller_length": 0.02});
-        v["crank_shaft"] = json!({"diameter": 0.045, "modulus": 2.06e11});
+        v["crank_shaft"] = json!({"diameter": 0.045, "modulus": 2.06e11, "poisson": 0.3});
         out.push(v.clone());
         v["contact"]["pin"]["damping"] = json!({"kind": "restitution", "model": "exact",
             "restitution": 0.8, "reference_speed": 0.1});

@@ -389,6 +389,7 @@ fn bending_scenes() -> Vec<Scene> {
     let shaft = crate::bearing::CrankShaft {
         diameter: 0.045,
         modulus: crate::bearing::crank_beam::STEEL_MODULUS,
+        poisson: crate::bearing::crank_beam::STEEL_POISSON,
     };
     let mut out: Vec<Scene> = vec![scenes()[3].clone(), Scene::physical("rated").unwrap()];
     for s in &mut out {
