@@ -377,28 +377,19 @@ impl Statics {
                     let (g, h) = eb.static_tangent(d);
                     let pa = perp(arm);
                     let pe = perp(ecc);
-                    let cols: [(usize, [f64; 2]); 6] = [
+                    // With bending, the eccentric's deflection enters as the crank centre does.
+                    let n = nk.unwrap_or(0);
+                    let all: [(usize, [f64; 2]); 8] = [
                         (dk, [1.0, 0.0]),
                         (dk + 1, [0.0, 1.0]),
                         (dk + 2, pa),
                         (ci, [-1.0, 0.0]),
                         (ci + 1, [0.0, -1.0]),
                         (ci + 2, [-pe[0], -pe[1]]),
+                        (n, [-1.0, 0.0]),
+                        (n + 1, [0.0, -1.0]),
                     ];
-                    let node_cols: [(usize, [f64; 2]); 2] = nk.map_or([(0, [0.0; 2]); 2], |n| {
-                        [(n, [-1.0, 0.0]), (n + 1, [0.0, -1.0])]
-                    });
-                    let all: [(usize, [f64; 2]); 8] = [
-                        cols[0],
-                        cols[1],
-                        cols[2],
-                        cols[3],
-                        cols[4],
-                        cols[5],
-                        node_cols[0],
-                        node_cols[1],
-                    ];
-                    let cols: &[(usize, [f64; 2])] = if nk.is_some() { &all } else { &cols };
+                    let cols = &all[..if nk.is_some() { 8 } else { 6 }];
                     add_bearing(qf, kf, cols, g, h);
                     if let Some(c) = cf.as_mut() {
                         add_bearing_damping(c, cols, eb.damping_matrix(d));

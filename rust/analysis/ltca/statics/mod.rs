@@ -355,8 +355,8 @@ impl Statics {
 
     /// The families of couplings of this scene, named as in reports: the pin contacts of each
     /// disc, the sun/planet meshes (with a first stage), the eccentric bearings (compliant
-    /// joints) and the crank bearings (when compliant). Their stiffness parts sum to the whole
-    /// tangent.
+    /// joints), the crank bearings (when compliant) and the crank bending (`crank_shaft`).
+    /// Their stiffness parts sum to the whole tangent.
     pub fn families(&self) -> Vec<(String, Family)> {
         let mut families: Vec<(String, Family)> = (0..self.model.discs.len())
             .map(|d| (format!("pin contacts disc {d}"), Family::Pins(d)))
