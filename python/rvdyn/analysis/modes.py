@@ -194,7 +194,11 @@ def modes(scene: Any, torque: float | None = None, crank_angle: float = 0.0, *,
     """Modes of ``scene`` (rigid or compliant joints, with or without machine shafts) about
     its loaded quasi-static equilibrium at ``crank_angle`` [rad] under the output torque
     ``torque`` [N m] (default: the scene's constant load torque), input held (the motor with a
-    drive shaft under a speed drive; free under a torque drive).
+    drive shaft under a speed drive; free under a torque drive). With ``crank_shaft`` the
+    eccentrics' bending deflections are condensed out (massless; the part ``"crank bending"``
+    holds their strain energy; docs/model.md, "Modes with bending crankshafts"); such a scene
+    needs eccentric bearings whose damping is proportional to their stiffness (rollers, or a
+    linear bearing without clearance), else :class:`rvdyn.SceneError`.
 
     state: ``(t, q, v)`` of a dynamic run of this scene instead of an equilibrium: time [s],
     the model's free coordinates [rad, m] and velocities [rad/s, m/s] in the order of the run

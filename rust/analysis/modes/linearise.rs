@@ -108,6 +108,23 @@ pub struct Linearizer {
     scale: Vec<f64>,
     output_shaft: Option<crate::dynamics::scene::Shaft>,
     input_shaft: Option<crate::dynamics::scene::Shaft>,
+    /// Eccentric deflections of bending crankshafts (`crank_shaft`) among the LTCA unknowns
+    /// (the last ones), condensed out of the linearisation (0 without bending).
+    nodes: usize,
+    /// With bending: the eccentric bearings' damping over their tangent stiffness \[s\]
+    /// (`C = ratio K`, exact for their laws; docs/model.md, "Modes with bending crankshafts").
+    eccentric_damping: f64,
+}
+
+/// The damping of an eccentric bearing over its tangent stiffness \[s\] when the two are
+/// proportional at every loaded pose: rollers without a parallel linear part (`beta`), or a
+/// linear bearing without clearance (`c / k`). Other bearings: `None`.
+fn proportional_damping(b: &crate::dynamics::scene::Bearing) -> Option<f64> {
+    match &b.rollers {
+        Some(r) if b.stiffness == 0.0 && b.damping == 0.0 => Some(r.beta()),
+        None if b.clearance == 0.0 && b.stiffness > 0.0 => Some(b.damping / b.stiffness),
+        _ => None,
+    }
 }
 
 impl Linearizer {
@@ -121,6 +138,36 @@ impl Linearizer {
         let ltca = Ltca::new(scene)?;
         let families = statics.families();
         let mut free_scene = scene.clone();
+        // Bending crankshafts: the dynamic model (for the masses and the damping) is the one
+        // with straight cranks, without the eccentric bearings' damping, which acts on the
+        // disc's motion relative to the deflected eccentric and is added from their tangent.
+        let nodes = if statics.bending.is_some() {
+            2 * statics.cranks * statics.model.discs.len()
+        } else {
+            0
+        };
+        let mut eccentric_damping = 0.0;
+        if nodes > 0 {
+            free_scene.crank_shaft = None;
+            if let Joints::Compliant {
+                eccentric_bearing, ..
+            } = &mut free_scene.joints
+            {
+                eccentric_damping = proportional_damping(eccentric_bearing).ok_or_else(|| {
+                    RvdynError::Scene(
+                        "modes with crank_shaft need eccentric bearings whose damping is \
+                         proportional to their stiffness: rollers without a parallel linear \
+                         spring or damper (joints.eccentric_bearing.stiffness = damping = 0), or \
+                         a linear bearing without clearance"
+                            .into(),
+                    )
+                })?;
+                eccentric_bearing.damping = 0.0;
+                if let Some(r) = eccentric_bearing.rollers.as_mut() {
+                    r.damping_ratio = 0.0;
+                }
+            }
+        }
         free_scene.drive = Drive::Torque {
             torque: 0.0,
             ramp_time: 0.0,
@@ -176,16 +223,18 @@ impl Linearizer {
             }
             Joints::Compliant { .. } => {
                 let m = CompliantModel::new(&free_scene)?;
-                let names = statics.unknowns.iter().map(|&i| full[i].clone()).collect();
-                let mass = statics.unknowns.iter().map(|&i| m.mass[i]).collect();
+                let kept = &statics.unknowns[..statics.dim() - nodes];
+                let names = kept.iter().map(|&i| full[i].clone()).collect();
+                let mass = kept.iter().map(|&i| m.mass[i]).collect();
                 (names, mass, Dynamic::Compliant(Box::new(m)))
             }
         };
+        let kept = statics.dim() - nodes;
         let mut dyn_index: Vec<usize> = match &dynamic {
-            Dynamic::Rigid(_) => (0..statics.dim()).collect(),
-            Dynamic::Compliant(_) => statics.unknowns.clone(),
+            Dynamic::Rigid(_) => (0..kept).collect(),
+            Dynamic::Compliant(_) => statics.unknowns[..kept].to_vec(),
         };
-        let mut scale = statics.scale.clone();
+        let mut scale = statics.scale[..kept].to_vec();
         let sun_lever = statics.model.mesh.map_or(1.0, |m| m.sun_base_radius);
         let rp = scene.cycloid.pin_circle_radius;
         for e in &extra {
@@ -255,6 +304,8 @@ impl Linearizer {
             scale,
             output_shaft: scene.shafts.output,
             input_shaft: scene.shafts.input,
+            nodes,
+            eccentric_damping,
         })
     }
 
@@ -330,7 +381,9 @@ impl Linearizer {
             }
             Dynamic::Compliant(m) => {
                 let mut x = vec![0.0; m.full_len()];
-                x[..full.len()].copy_from_slice(full);
+                // Without the eccentric deflections of bending cranks (not the model's).
+                let body = full.len() - self.nodes;
+                x[..body].copy_from_slice(&full[..body]);
                 if let Some(i) = m.load_index {
                     x[i] = shaft_angles[0];
                 }
@@ -443,18 +496,30 @@ impl Linearizer {
     /// dynamic force: contact damping `c(pen) pen'` and friction at speed).
     pub fn linearise_about(&mut self, mut eq: Equilibrium) -> Result<(LinearSystem, Equilibrium)> {
         let n = self.names.len();
-        let mut k_all = self.reducer_stiffness(&eq)?;
+        let k_big = self.reducer_stiffness(&eq)?;
+        // Bending crankshafts: the eccentric deflections are condensed out, `K -> T^T K T`
+        // for the whole tangent and for each part alike (so the parts still add up).
+        let t = self.condensation(&k_big, &eq)?;
+        let small = |k: DMatrix<f64>| match &t {
+            Some(t) => t.transpose() * k * t,
+            None => k,
+        };
+        let mut k_all = small(k_big);
         let mut parts = Vec::with_capacity(self.families.len() + 2);
         let mut sum = DMatrix::<f64>::zeros(n, n);
+        let mut eccentric = None;
         for (name, fam) in self.families.clone() {
             self.statics.family = Some(fam);
             let k = self.reducer_stiffness(&eq);
             self.statics.family = None;
-            let k = k?;
+            let k = small(k?);
             sum += &k;
+            if self.nodes > 0 && fam == Family::EccentricBearings {
+                eccentric = Some(k.clone());
+            }
             parts.push(StiffnessPart { name, matrix: k });
         }
-        if let Some(ks) = self.shaft_stiffness() {
+        if let Some(ks) = self.shaft_stiffness().map(small) {
             k_all += &ks;
             sum += &ks;
             parts.push(StiffnessPart {
@@ -477,7 +542,10 @@ impl Linearizer {
         } else {
             0.0
         };
-        let damping = self.damping_matrix(&eq)?;
+        let mut damping = self.damping_matrix(&eq)?;
+        if let Some(k) = eccentric {
+            damping += k * self.eccentric_damping;
+        }
         let sys = LinearSystem {
             dof_names: self.names.clone(),
             mass: DMatrix::from_diagonal(&DVector::from_vec(self.mass.clone())),
@@ -486,6 +554,42 @@ impl Linearizer {
             length_scale: self.scale.clone(),
         };
         Ok((sys, eq))
+    }
+
+    /// With bending crankshafts, the static condensation of the eccentric deflections (the
+    /// nodes, massless): `T` (big x small) with the identity on the kept coordinates and
+    /// `-K_nn^-1 K_nk` on the nodes, so that `T^T K T` is the stiffness the kept coordinates
+    /// see with each node in balance (Guyan 1965). `None` without bending.
+    pub(crate) fn condensation(
+        &self,
+        k: &DMatrix<f64>,
+        eq: &Equilibrium,
+    ) -> Result<Option<DMatrix<f64>>> {
+        if self.nodes == 0 {
+            return Ok(None);
+        }
+        let n = self.names.len();
+        let nn = self.nodes;
+        let first = self.statics.dim() - nn;
+        let big = |a: usize| if a < first { a } else { a + nn };
+        let knn = k.view((first, first), (nn, nn)).into_owned();
+        let knk = DMatrix::from_fn(nn, n, |r, a| k[(first + r, big(a))]);
+        let lu = knn.lu();
+        let Some(x) = lu.solve(&knk).filter(|x| x.iter().all(|v| v.is_finite())) else {
+            return Err(RvdynError::Convergence(format!(
+                "the crankshafts' bending stiffness at crank angle {:.6} rad is singular: no \
+                 static condensation of the eccentric deflections (check crank_shaft)",
+                eq.crank_angle
+            )));
+        };
+        let mut t = DMatrix::<f64>::zeros(n + nn, n);
+        for a in 0..n {
+            t[(big(a), a)] = 1.0;
+            for r in 0..nn {
+                t[(first + r, a)] = -x[(r, a)];
+            }
+        }
+        Ok(Some(t))
     }
 
     /// The analytic tangent stiffness `-dQ/dq` of the LTCA unknowns at an equilibrium [N/m,
@@ -507,13 +611,15 @@ impl Linearizer {
         Ok(DMatrix::from_row_slice(n, n, &k.a))
     }
 
-    /// The reducer's analytic tangent stiffness on all the linearisation's coordinates: that
+    /// The reducer's analytic tangent stiffness on all the linearisation's coordinates (with
+    /// bending crankshafts before their condensation: the eccentric deflections after the
+    /// other LTCA unknowns, the shafts' coordinates after them): that
     /// of the LTCA unknowns, and with a drive shaft the sun's row and column (`J^T K_full e_s`
     /// with the map Jacobian `J` of the unknowns; the sun enters the map linearly).
-    fn reducer_stiffness(&mut self, eq: &Equilibrium) -> Result<DMatrix<f64>> {
+    pub(crate) fn reducer_stiffness(&mut self, eq: &Equilibrium) -> Result<DMatrix<f64>> {
         let k0 = self.tangent_stiffness(eq)?;
         let n0 = k0.nrows();
-        let n = self.names.len();
+        let n = self.names.len() + self.nodes;
         let mut k = DMatrix::<f64>::zeros(n, n);
         k.view_mut((0, 0), (n0, n0)).copy_from(&k0);
         if let Some(s) = self.extra.iter().position(|e| *e == Extra::Sun) {
@@ -586,7 +692,7 @@ impl Linearizer {
         if self.extra.is_empty() {
             return None;
         }
-        let n = self.names.len();
+        let n = self.names.len() + self.nodes;
         let n0 = self.statics.dim();
         let at = |e: Extra| self.extra.iter().position(|x| *x == e).map(|p| n0 + p);
         let mut k = DMatrix::<f64>::zeros(n, n);

@@ -900,8 +900,8 @@ pub struct Scene {
     #[serde(default)]
     pub crank_layout: Option<crate::bearing::CrankLayout>,
     /// The crankshafts' section, for their bending between the bearings in the quasi-static
-    /// analyses (needs `crank_layout` and compliant joints; default: none, rigid cranks). The
-    /// dynamic model and the modes do not model it and refuse such a scene.
+    /// analyses and the modes (needs `crank_layout` and compliant joints; default: none, rigid
+    /// cranks). The dynamic model does not model it and refuses such a scene.
     #[serde(default)]
     pub crank_shaft: Option<crate::bearing::CrankShaft>,
     /// The input drive.

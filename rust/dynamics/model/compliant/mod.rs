@@ -160,8 +160,9 @@ impl CompliantModel {
             return Err(RvdynError::Scene(
                 "crank_shaft (the crankshafts' bending) is modelled by the quasi-static analyses \
                  only (rvdyn.ltca, transmission_error, torque_twist, compliance_budget, tolerance \
-                 studies with the LTCA kernel); the dynamic model and the modes treat the cranks \
-                 as rigid: remove crank_shaft for this scene (scene.replace(crank_shaft=None))"
+                 studies with the LTCA kernel) and the modes about an equilibrium; the dynamic \
+                 model treats the cranks as rigid: remove crank_shaft for a simulation \
+                 (scene.replace(crank_shaft=None))"
                     .into(),
             ));
         }
