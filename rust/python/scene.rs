@@ -201,12 +201,7 @@ impl CompiledScene {
 fn model_info<'py>(py: Python<'py>, sc: &Scene) -> PyResult<Bound<'py, PyDict>> {
     let dof = match sc.joints {
         Joints::Rigid => None,
-        Joints::Compliant { .. } => {
-            // The dynamic model's coordinates (crankshaft bending is the LTCA's only).
-            let mut dynamic = sc.clone();
-            dynamic.crank_shaft = None;
-            Some(CompliantModel::new(&dynamic)?.dof())
-        }
+        Joints::Compliant { .. } => Some(CompliantModel::new(sc)?.dof()),
     };
     let model = RigidModel::new(&sc.rigid_counterpart())?;
     let d = PyDict::new(py);

@@ -402,10 +402,18 @@ impl Linearizer {
     /// taken as it is (no equilibrium is solved): the held input at its angle at `t`, the
     /// crank angle that puts it there.
     ///
-    /// Errors: a scene with other joints or shafts, a state of the wrong length or not
+    /// Errors: a scene with `crank_shaft` (`Scene`); a scene with other joints or shafts, a state of the wrong length or not
     /// finite (`Parameter`).
     pub fn state_point(&self, scene: &Scene, t: f64, q: &[f64], v: &[f64]) -> Result<Equilibrium> {
         require_finite("time", t)?;
+        if self.nodes > 0 {
+            return Err(RvdynError::Scene(
+                "modes about a dynamic state of a scene with crank_shaft are not available (the \
+                 run's eccentrics carry mass, the linearisation condenses them as massless): \
+                 linearise about an equilibrium instead (rvdyn.modes(scene, torque, crank_angle))"
+                    .into(),
+            ));
+        }
         if !q.iter().chain(v).all(|x| x.is_finite()) {
             return Err(RvdynError::Parameter(
                 "the state (q, v) must be finite".into(),

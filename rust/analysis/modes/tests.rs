@@ -807,17 +807,7 @@ fn state_of_a_slow_run_linearises_like_the_equilibrium() {
 /// apart; as the LTCA's tests).
 fn bending_physical() -> Scene {
     let mut s = Scene::physical("rated").unwrap();
-    s.crank_layout = Some(crate::bearing::CrankLayout {
-        bearings: [-0.06, 0.06],
-        discs: vec![-0.02, 0.02],
-        planet: -0.09,
-        roller_length: None,
-    });
-    s.crank_shaft = Some(crate::bearing::CrankShaft {
-        diameter: 0.045,
-        modulus: crate::bearing::crank_beam::STEEL_MODULUS,
-        poisson: crate::bearing::crank_beam::STEEL_POISSON,
-    });
+    crate::test_util::with_bending_cranks(&mut s);
     s.validate().unwrap();
     s
 }

@@ -900,8 +900,8 @@ pub struct Scene {
     #[serde(default)]
     pub crank_layout: Option<crate::bearing::CrankLayout>,
     /// The crankshafts' section, for their bending between the bearings in the quasi-static
-    /// analyses and the modes (needs `crank_layout` and compliant joints; default: none, rigid
-    /// cranks). The dynamic model does not model it and refuses such a scene.
+    /// analyses, the modes and the dynamic model (needs `crank_layout` and compliant joints;
+    /// default: none, rigid cranks).
     #[serde(default)]
     pub crank_shaft: Option<crate::bearing::CrankShaft>,
     /// The input drive.

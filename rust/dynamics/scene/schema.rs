@@ -1131,7 +1131,7 @@ pub static FIELDS: &[Field] = &[
         "-",
         NULL,
         "needs crank_layout and compliant joints",
-        "the crankshafts' round section, for their bending between the bearings in the quasi-static analyses (null = rigid cranks; and in the modes, condensed; a simulation refuses a scene with it; docs/model.md, Crankshaft bending)",
+        "the crankshafts' round section, for their bending between the bearings (null = rigid cranks): in the quasi-static analyses, the modes and the dynamic model; docs/model.md, Crankshaft bending",
     ),
     f(
         "crank_shaft.diameter",

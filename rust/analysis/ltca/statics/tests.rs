@@ -380,21 +380,9 @@ fn tangent_matches_finite_differences_of_the_forces() {
 /// clearance, and the physical preset with its roller bearings, the two discs 40 mm apart
 /// between bearings 120 mm apart on a 45 mm shaft.
 fn bending_scenes() -> Vec<Scene> {
-    let layout = crate::bearing::CrankLayout {
-        bearings: [-0.06, 0.06],
-        discs: vec![-0.02, 0.02],
-        planet: -0.09,
-        roller_length: None,
-    };
-    let shaft = crate::bearing::CrankShaft {
-        diameter: 0.045,
-        modulus: crate::bearing::crank_beam::STEEL_MODULUS,
-        poisson: crate::bearing::crank_beam::STEEL_POISSON,
-    };
     let mut out: Vec<Scene> = vec![scenes()[3].clone(), Scene::physical("rated").unwrap()];
     for s in &mut out {
-        s.crank_layout = Some(layout.clone());
-        s.crank_shaft = Some(shaft);
+        crate::test_util::with_bending_cranks(s);
         s.validate().unwrap();
     }
     out

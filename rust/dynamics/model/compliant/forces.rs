@@ -11,6 +11,9 @@ use crate::dynamics::model::vec2::{add, cross, dot, perp, rotate, scaled, sub};
 use crate::dynamics::run::sink::ContactSink;
 use crate::error::{Result, RvdynError};
 
+/// Most discs a bending crank carries (a scene has one or two).
+const MAX_BENDING_DISCS: usize = 2;
+
 impl CompliantModel {
     /// Generalised forces `qf` on every full coordinate at `(t, x, v)`, reporting every
     /// contact to `sink`.
@@ -63,13 +66,19 @@ impl CompliantModel {
                     out.friction[2] += m * w;
                 }
             }
-            // Eccentric bearings: force on the disc at H, opposite on the crank at E.
+            // Eccentric bearings: force on the disc at H, opposite on the crank at E (or on the
+            // eccentric's own centre when the crank bends, see below).
             for (k, disc) in m.discs.iter().enumerate() {
                 let dk = self.disc_index(k);
                 let (sa, ca) = (alpha + disc.phase + self.ecc_phase[i]).sin_cos();
                 let ecc = [self.ecc_radius[i] * ca, self.ecc_radius[i] * sa];
-                let e_pos = add(p, ecc);
-                let e_v = add(pv, scaled(va, perp(ecc)));
+                let mut e_pos = add(p, ecc);
+                let mut e_v = add(pv, scaled(va, perp(ecc)));
+                let node = self.bending.as_ref().map(|_| self.node_index(i, k));
+                if let Some(ni) = node {
+                    e_pos = [x[ni], x[ni + 1]];
+                    e_v = [v[ni], v[ni + 1]];
+                }
                 let o = [x[dk], x[dk + 1]];
                 let ov = [v[dk], v[dk + 1]];
                 let arm = rotate(x[dk + 2], self.holes[i * nd + k]);
@@ -81,9 +90,14 @@ impl CompliantModel {
                 qf[dk] += f[0];
                 qf[dk + 1] += f[1];
                 qf[dk + 2] += cross(arm, f);
-                qf[ci] -= f[0];
-                qf[ci + 1] -= f[1];
-                qf[ci + 2] -= cross(ecc, f);
+                if let Some(ni) = node {
+                    qf[ni] -= f[0];
+                    qf[ni + 1] -= f[1];
+                } else {
+                    qf[ci] -= f[0];
+                    qf[ci + 1] -= f[1];
+                    qf[ci + 2] -= cross(ecc, f);
+                }
                 out.dissipation += b.dissipation;
                 out.potential += b.energy;
                 if let Some([(pf, w_reg), _]) = &self.bearing_friction {
@@ -94,6 +108,34 @@ impl CompliantModel {
                     qf[dk + 2] += m;
                     out.dissipation += m * w;
                     out.friction[2] += m * w;
+                }
+            }
+            // Crank bending: each eccentric centre is tied to where the straight crank puts
+            // it, `u_k = w_k - (p + ecc_k)`, by the shaft's stiffness (the same in x and y);
+            // the reaction goes to the crank at that point. No damping of its own.
+            if let Some(bend) = &self.bending {
+                let mut u = [[0.0; 2]; MAX_BENDING_DISCS];
+                let mut eccs = [[0.0; 2]; MAX_BENDING_DISCS];
+                for (k, disc) in m.discs.iter().enumerate() {
+                    let (sa, ca) = (alpha + disc.phase + self.ecc_phase[i]).sin_cos();
+                    eccs[k] = [self.ecc_radius[i] * ca, self.ecc_radius[i] * sa];
+                    let ni = self.node_index(i, k);
+                    u[k] = sub([x[ni], x[ni + 1]], add(p, eccs[k]));
+                }
+                for k in 0..nd {
+                    let mut fk = [0.0; 2];
+                    for (l, ul) in u.iter().enumerate().take(nd) {
+                        let kk = bend.stiffness[k * nd + l];
+                        fk[0] += kk * ul[0];
+                        fk[1] += kk * ul[1];
+                    }
+                    let ni = self.node_index(i, k);
+                    qf[ni] -= fk[0];
+                    qf[ni + 1] -= fk[1];
+                    qf[ci] += fk[0];
+                    qf[ci + 1] += fk[1];
+                    qf[ci + 2] += cross(eccs[k], fk);
+                    out.potential += 0.5 * dot(u[k], fk);
                 }
             }
             // Sun/planet mesh i. The sun pushes planet i along w_i = sin(pa) u_i + cos(pa)

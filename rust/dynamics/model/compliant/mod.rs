@@ -96,6 +96,41 @@ pub(crate) struct Flows {
     friction: [f64; 3],
 }
 
+/// Bending crankshafts in the dynamic model (docs/model.md, "Crankshaft bending in the
+/// dynamic model").
+#[derive(Debug, Clone)]
+pub(crate) struct Bending {
+    /// The eccentrics' stiffness against bending [N/m], row-major `discs x discs`, the same in
+    /// `x` and `y` ([`crate::bearing::CrankShaft::stiffness`]).
+    pub(crate) stiffness: Vec<f64>,
+    /// Mass moving with each eccentric's centre [kg]: the shaft's section over the disc's
+    /// width.
+    pub(crate) mass: f64,
+}
+
+impl Bending {
+    /// From a validated scene; `None` without `crank_shaft`. Errors (`Scene`): eccentrics
+    /// heavier than the crank they are part of.
+    fn of(scene: &Scene, discs: usize, crank_mass: f64) -> Result<Option<Self>> {
+        let (Some(shaft), Some(layout)) = (&scene.crank_shaft, &scene.crank_layout) else {
+            return Ok(None);
+        };
+        let stiffness = shaft
+            .stiffness(layout)
+            .map_err(|e| RvdynError::Scene(format!("crank_shaft: {e}")))?;
+        let width = scene.cycloid.face_width;
+        let mass = scene.density * 0.25 * std::f64::consts::PI * shaft.diameter.powi(2) * width;
+        if discs as f64 * mass >= crank_mass {
+            return Err(RvdynError::Scene(format!(
+                "crank_shaft: the eccentrics ({discs} x {mass:.4} kg: the shaft's section over \
+                 the disc width) are heavier than the crank ({crank_mass:.4} kg, \
+                 inertias.crank.mass): give the crank its real mass or a thinner shaft"
+            )));
+        }
+        Ok(Some(Self { stiffness, mass }))
+    }
+}
+
 /// The compliant-joint reducer model (a [`MechanicalSystem`] in its free coordinates).
 #[derive(Debug, Clone)]
 pub struct CompliantModel {
@@ -146,6 +181,9 @@ pub struct CompliantModel {
     /// Palmgren friction of the eccentric and crank bearings, with the regularisation speeds
     /// [rad/s] of their relative rotation.
     bearing_friction: Option<[(PalmgrenFriction, f64); 2]>,
+    /// Bending crankshafts (`crank_shaft`): each eccentric centre is then a body of its own,
+    /// tied to its crank's line by the shaft's stiffness.
+    pub(crate) bending: Option<Bending>,
     /// Index of the load angle in the full vector (with an output shaft).
     pub(crate) load_index: Option<usize>,
     /// Index of the motor angle in the full vector (with a drive shaft).
@@ -156,16 +194,6 @@ impl CompliantModel {
     /// Build the model of a validated scene with `joints = Compliant {..}`.
     pub fn new(scene: &Scene) -> Result<Self> {
         scene.validate()?;
-        if scene.crank_shaft.is_some() {
-            return Err(RvdynError::Scene(
-                "crank_shaft (the crankshafts' bending) is modelled by the quasi-static analyses \
-                 only (rvdyn.ltca, transmission_error, torque_twist, compliance_budget, tolerance \
-                 studies with the LTCA kernel) and the modes about an equilibrium; the dynamic \
-                 model treats the cranks as rigid: remove crank_shaft for a simulation \
-                 (scene.replace(crank_shaft=None))"
-                    .into(),
-            ));
-        }
         let Joints::Compliant {
             eccentric_bearing,
             crank_bearing,
@@ -258,18 +286,30 @@ impl CompliantModel {
         } else {
             inr.motor_inertia
         };
+        let bending = Bending::of(scene, nd, inr.crank.mass)?;
+        // The eccentrics of bending cranks carry their own mass (their orbit on the carrier
+        // with it): the crank keeps the rest.
+        let crank_mass = inr.crank.mass - bending.as_ref().map_or(0.0, |b| nd as f64 * b.mass);
+        let crank_orbit = crank_orbit * crank_mass / inr.crank.mass;
         let mut mass = vec![
             inr.carrier.inertia + on_carrier + crank_orbit,
             inr.sun.inertia + on_sun,
         ];
         let mut lever = vec![rp, base.mesh.map_or(0.0, |m| m.sun_base_radius)];
         for _ in 0..n {
-            mass.extend([inr.crank.mass, inr.crank.mass, inr.crank.inertia]);
+            mass.extend([crank_mass, crank_mass, inr.crank.inertia]);
             lever.extend([1.0, 1.0, crank_lever]);
         }
         for _ in 0..nd {
             mass.extend([inr.disc.mass, inr.disc.mass, inr.disc.inertia]);
             lever.extend([1.0, 1.0, rp]);
+        }
+        if let Some(b) = &bending {
+            // Each eccentric's centre, crank by crank (as the LTCA's deflections).
+            for _ in 0..2 * n * nd {
+                mass.push(b.mass);
+                lever.push(1.0);
+            }
         }
         let mut load_index = None;
         if base.output_shaft.is_some() {
@@ -353,7 +393,16 @@ impl CompliantModel {
             bearing_friction,
             load_index,
             motor_index,
+            bending,
         })
+    }
+
+    /// Index of the `x` of crank `i`'s eccentric for disc `k` (bending cranks; `y` follows)
+    /// in the full vector: after the discs, as the LTCA's deflections.
+    #[inline]
+    pub fn node_index(&self, i: usize, k: usize) -> usize {
+        let nd = self.parts.discs.len();
+        2 + 3 * self.cranks + 3 * nd + 2 * (i * nd + k)
     }
 
     /// Number of full coordinates.
@@ -407,6 +456,19 @@ impl CompliantModel {
             let ov = scaled(wa, perp(o));
             x[dk..dk + 3].copy_from_slice(&[o[0], o[1], d.angle_offset]);
             v[dk..dk + 3].copy_from_slice(&[ov[0], ov[1], wc]);
+            if self.bending.is_some() {
+                // Straight cranks: each eccentric centre on its crank.
+                for i in 0..self.cranks {
+                    let ci = crank_index(i);
+                    let (s, c) = (d.phase + self.ecc_phase[i]).sin_cos();
+                    let ecc = scaled(self.ecc_radius[i], [c, s]);
+                    let e_pos = add([x[ci], x[ci + 1]], ecc);
+                    let e_v = add([v[ci], v[ci + 1]], scaled(v[ci + 2], perp(ecc)));
+                    let ni = self.node_index(i, k);
+                    x[ni..ni + 2].copy_from_slice(&e_pos);
+                    v[ni..ni + 2].copy_from_slice(&e_v);
+                }
+            }
         }
         if let Some(li) = self.load_index {
             v[li] = v[CARRIER];
