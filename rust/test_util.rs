@@ -19,5 +19,6 @@ pub(crate) fn with_bending_cranks(scene: &mut crate::dynamics::scene::Scene) {
         diameter: 0.045,
         modulus: crate::bearing::crank_beam::STEEL_MODULUS,
         poisson: crate::bearing::crank_beam::STEEL_POISSON,
+        eccentric_mass: None,
     });
 }

@@ -30,3 +30,21 @@ def pin_centre(j: int) -> np.ndarray:
     """Centre [m] of pin j (0-based; the paper's pin j + 1)."""
     th = 2.0 * math.pi * j / ZP
     return np.array([RP * math.cos(th), RP * math.sin(th)])
+
+
+def ringing(eta: np.ndarray, dt: float, periods: int = 8) -> tuple[float, float]:
+    """Frequency [Hz] and damping ratio of the dominant mode in a decaying signal ``eta``
+    (mean removed, samples ``dt`` [s] apart): the peak of its zero-padded FFT, and the
+    logarithmic decrement over ``periods`` periods of its positive maxima (each refined by a
+    parabola through three samples)."""
+    spec = np.abs(np.fft.rfft(eta, 1 << 20))
+    f_fft = float(np.fft.rfftfreq(1 << 20, dt)[5 + np.argmax(spec[5:])])
+    peaks = []
+    for j in range(1, len(eta) - 1):
+        if eta[j] > 0 and eta[j] > eta[j - 1] and eta[j] >= eta[j + 1]:
+            a, b, c = eta[j - 1], eta[j], eta[j + 1]
+            d = 0.5 * (a - c) / (a - 2 * b + c)
+            peaks.append(b - 0.25 * (a - c) * d)
+    assert len(peaks) > periods + 1
+    delta = math.log(peaks[0] / peaks[periods]) / periods
+    return f_fft, delta / math.sqrt(4 * math.pi**2 + delta**2)

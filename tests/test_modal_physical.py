@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import rvdyn
+from conftest import ringing
 
 RATED = 43921.26037602  # 57 x 112 kW / 8328 deg/s [N m]
 
@@ -51,20 +52,8 @@ def test_physical_main_torsional_mode_matches_the_free_vibration() -> None:
     m = rvdyn.modes(scene, torque=RATED, crank_angle=psi)
     assert m.dominant_dof[0] == "carrier angle"
     sel = res.t >= tp + 2e-4
-    eta = res.carrier_speed[sel] - res.carrier_speed[sel].mean()
-    spec = np.abs(np.fft.rfft(eta, 1 << 20))
-    freq = np.fft.rfftfreq(1 << 20, 1e-5)
-    f_fft = freq[5 + np.argmax(spec[5:])]
+    f_fft, zeta = ringing(res.carrier_speed[sel] - res.carrier_speed[sel].mean(), 1e-5)
     assert f_fft == pytest.approx(m.damped_frequency[0], rel=0.01)
-    peaks = []
-    for j in range(1, len(eta) - 1):
-        if eta[j] > 0 and eta[j] > eta[j - 1] and eta[j] >= eta[j + 1]:
-            a, b, c = eta[j - 1], eta[j], eta[j + 1]
-            d = 0.5 * (a - c) / (a - 2 * b + c)
-            peaks.append(b - 0.25 * (a - c) * d)
-    assert len(peaks) > 9
-    delta = math.log(peaks[0] / peaks[8]) / 8
-    zeta = delta / math.sqrt(4 * math.pi ** 2 + delta ** 2)
     assert zeta == pytest.approx(m.damping_ratio[0], rel=0.05)
 
 

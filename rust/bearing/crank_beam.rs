@@ -45,6 +45,11 @@ pub struct CrankShaft {
     /// Poisson's ratio \[-\] (default steel, 0.3), for the shear modulus.
     #[serde(default = "steel_poisson")]
     pub poisson: f64,
+    /// Mass \[kg\] moving with each eccentric's centre in the dynamic model (taken from the
+    /// crank's); `None`: the shaft's section over the disc's width at the scene's density. The
+    /// quasi-static analyses and the modes take the eccentrics as massless.
+    #[serde(default)]
+    pub eccentric_mass: Option<f64>,
 }
 
 impl CrankShaft {
@@ -67,6 +72,14 @@ impl CrankShaft {
             return Err(RvdynError::Parameter(format!(
                 "poisson must be in [0, 0.5) (steel 0.3), got {}",
                 self.poisson
+            )));
+        }
+        if let Some(m) = self.eccentric_mass
+            && !(m.is_finite() && m > 0.0)
+        {
+            return Err(RvdynError::Parameter(format!(
+                "eccentric_mass must be a positive mass [kg] (null: the shaft's section over the \
+                 disc width), got {m}"
             )));
         }
         Ok(())
@@ -98,7 +111,7 @@ impl CrankShaft {
     /// let layout = CrankLayout {
     ///     bearings: [0.0, 0.1], discs: vec![0.05], planet: -0.03, roller_length: None,
     /// };
-    /// let shaft = CrankShaft { diameter: 0.04, modulus: 2.06e11, poisson: 0.3 };
+    /// let shaft = CrankShaft { diameter: 0.04, modulus: 2.06e11, poisson: 0.3, eccentric_mass: None };
     /// let c = shaft.flexibility(&layout).unwrap();
     /// // Mid-span: L^3 / (48 E I) + L / (4 kappa G A).
     /// let want = 0.1f64.powi(3) / (48.0 * shaft.bending_stiffness())
@@ -238,6 +251,7 @@ mod tests {
             diameter: 0.04,
             modulus: STEEL_MODULUS,
             poisson: STEEL_POISSON,
+            eccentric_mass: None,
         };
         let ei = s.bending_stiffness();
         let gas = s.shear_stiffness();
@@ -289,6 +303,7 @@ mod tests {
                 diameter: d,
                 modulus: e,
                 poisson: nu,
+                eccentric_mass: None,
             }
             .flexibility(&l)
             .unwrap_err();
@@ -298,6 +313,7 @@ mod tests {
             diameter: 0.04,
             modulus: STEEL_MODULUS,
             poisson: STEEL_POISSON,
+            eccentric_mass: None,
         };
         let err = s.flexibility(&layout([0.0, 0.1], vec![0.1])).unwrap_err();
         assert!(err.to_string().contains("bearing's plane"), "{err}");

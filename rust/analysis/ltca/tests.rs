@@ -1300,6 +1300,7 @@ fn bending_of_a_one_disc_crank_is_a_softer_eccentric_bearing() {
         diameter: 0.04,
         modulus: 2.06e11,
         poisson: 0.3,
+        eccentric_mass: None,
     };
     let c11 = shaft.flexibility(&layout).unwrap()[0];
     bent.crank_layout = Some(layout);

@@ -1161,6 +1161,15 @@ pub static FIELDS: &[Field] = &[
         "Poisson's ratio of the shaft (steel), for its shear modulus",
     ),
     f(
+        "crank_shaft.eccentric_mass",
+        "",
+        "number or null",
+        "kg",
+        NULL,
+        "> 0, below the crank's mass per disc",
+        "mass moving with each eccentric's centre in the dynamic model, taken from the crank's (null = the shaft's section over the disc width; the quasi-static analyses and the modes take the eccentrics as massless)",
+    ),
+    f(
         "shafts",
         "",
         "object",
@@ -1526,7 +1535,8 @@ mod tests {
         v["joints"]["crank_bearing"]["damping"] = json!(1e3);
         v["crank_layout"] = json!({"bearings": [-0.06, 0.06], "discs": [-0.02, 0.02],
             "planet": -0.09, "roller_length": 0.02});
-        v["crank_shaft"] = json!({"diameter": 0.045, "modulus": 2.06e11, "poisson": 0.3});
+        v["crank_shaft"] =
+            json!({"diameter": 0.045, "modulus": 2.06e11, "poisson": 0.3, "eccentric_mass": 0.3});
         out.push(v.clone());
         v["contact"]["pin"]["damping"] = json!({"kind": "restitution", "model": "exact",
             "restitution": 0.8, "reference_speed": 0.1});

@@ -103,8 +103,8 @@ pub(crate) struct Bending {
     /// The eccentrics' stiffness against bending [N/m], row-major `discs x discs`, the same in
     /// `x` and `y` ([`crate::bearing::CrankShaft::stiffness`]).
     pub(crate) stiffness: Vec<f64>,
-    /// Mass moving with each eccentric's centre [kg]: the shaft's section over the disc's
-    /// width.
+    /// Mass moving with each eccentric's centre [kg] (`crank_shaft.eccentric_mass`, by
+    /// default the shaft's section over the disc's width).
     pub(crate) mass: f64,
 }
 
@@ -119,12 +119,15 @@ impl Bending {
             .stiffness(layout)
             .map_err(|e| RvdynError::Scene(format!("crank_shaft: {e}")))?;
         let width = scene.cycloid.face_width;
-        let mass = scene.density * 0.25 * std::f64::consts::PI * shaft.diameter.powi(2) * width;
+        let mass = shaft.eccentric_mass.unwrap_or(
+            scene.density * 0.25 * std::f64::consts::PI * shaft.diameter.powi(2) * width,
+        );
         if discs as f64 * mass >= crank_mass {
             return Err(RvdynError::Scene(format!(
-                "crank_shaft: the eccentrics ({discs} x {mass:.4} kg: the shaft's section over \
-                 the disc width) are heavier than the crank ({crank_mass:.4} kg, \
-                 inertias.crank.mass): give the crank its real mass or a thinner shaft"
+                "crank_shaft: the eccentrics ({discs} x {mass:.4} kg, eccentric_mass or by \
+                 default the shaft's section over the disc width) are heavier than the crank \
+                 ({crank_mass:.4} kg, inertias.crank.mass): give the crank its real mass, the \
+                 eccentrics a smaller one or the shaft a smaller diameter"
             )));
         }
         Ok(Some(Self { stiffness, mass }))
