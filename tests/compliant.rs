@@ -91,6 +91,7 @@ fn simulate_compliant_records_all_channels() {
         ("bearing_friction_power", &[]),
         ("crank_bearing_force", &[3, 2]),
         ("eccentric_bearing_force", &[3, 2, 2]),
+        ("crank_deflection", &[3, 2, 2]),
     ];
     assert_eq!(r.series.len(), expected.len());
     for (name, shape) in expected {

@@ -76,6 +76,10 @@ def test_eccentric_deflections_of_the_run_are_the_ltca_s(slow_run: tuple[Scene, 
     scale = np.abs(want).max()
     assert scale > 5e-5
     np.testing.assert_allclose(u, want, rtol=0, atol=1e-4 * scale)
+    # The recorded channel (bearings) is the same deflection, at every sample.
+    assert run.crank_deflection.shape == (run.t.size, 3, 2, 2)
+    np.testing.assert_allclose(run.crank_deflection[-1], u, rtol=0, atol=1e-12 * scale)
+    assert np.abs(run.crank_deflection[run.t.size // 2]).max() > 0.5 * scale
 
 
 def test_energy_balance_closes_with_bending_cranks() -> None:
@@ -133,6 +137,10 @@ def test_the_eccentrics_take_their_mass_from_the_crank() -> None:
     bent = base.replace(crank_shaft=SHAFT)
     m_node = 7850.0 * math.pi / 4 * 0.045**2 * 0.04
     assert bent.model_info()["dof"] == base.model_info()["dof"] + 12
+    # Straight cranks record no deflection.
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=START_IMPACT, category=RuntimeWarning)
+        assert not np.any(simulate(base, 1e-3, channels=["bearings"]).crank_deflection)
     with pytest.raises(rvdyn.SceneError, match="heavier than the crank"):
         simulate(bent.replace(**{"inertias.crank": {"mass": 1.5 * m_node, "inertia": 6.55e-3}}), 1e-4)
     with pytest.raises(rvdyn.SceneError, match="eccentric_mass must be a positive mass"):

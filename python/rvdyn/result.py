@@ -126,6 +126,7 @@ class Result:
     bearing_friction_power: _Channel[np.float64] = _Channel()
     crank_bearing_force: _Channel[np.float64] = _Channel()
     eccentric_bearing_force: _Channel[np.float64] = _Channel()
+    crank_deflection: _Channel[np.float64] = _Channel()
 
     def __init__(self, arrays: dict[str, NDArray[Any]], stats: dict[str, Any], scene: dict[str, Any] | None = None,
                  options: dict[str, Any] | None = None, error: RvdynError | None = None):

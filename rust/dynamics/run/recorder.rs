@@ -396,6 +396,14 @@ pub static CHANNELS: &[ChannelSpec] = &[
         "force of the eccentric bearing of crank i on disc k, fixed frame (ideal joints: the \
          reactions from each disc's balance, split as equal bearings share them)",
     ),
+    spec(
+        "crank_deflection",
+        Some(Bearings),
+        &[Dim::Cranks, Dim::Discs, Dim::Xy],
+        "m",
+        "deflection of crank i's eccentric for disc k from the crank's line, fixed frame \
+         (bending crankshafts, crank_shaft; 0 for straight cranks)",
+    ),
 ];
 
 /// One recorded array: flat data and the shape of one sample.
@@ -441,6 +449,8 @@ pub(crate) struct SampleSink {
     /// Crank bearing forces `(cranks, 2)` and eccentric bearing forces `(cranks, discs, 2)`.
     pub crank_bearing: Vec<f64>,
     pub eccentric_bearing: Vec<f64>,
+    /// Eccentric deflections of bending cranks `(cranks, discs, 2)`.
+    pub crank_deflection: Vec<f64>,
 }
 
 impl ContactSink for SampleSink {
@@ -481,6 +491,11 @@ impl ContactSink for SampleSink {
         if let Some(f) = self.mesh_force.get_mut(i) {
             *f = force;
             self.mesh_deflection[i] = deflection;
+        }
+    }
+    fn crank_deflection(&mut self, index: usize, deflection: [f64; 2]) {
+        if let Some(slot) = self.crank_deflection.get_mut(2 * index..2 * index + 2) {
+            slot.copy_from_slice(&deflection);
         }
     }
     fn bearing(&mut self, family: usize, index: usize, force: [f64; 2]) {
@@ -546,6 +561,7 @@ impl Recorder {
             mesh_deflection: vec![0.0; nm],
             crank_bearing: vec![0.0; 2 * layout.cranks],
             eccentric_bearing: vec![0.0; 2 * layout.cranks * nd],
+            crank_deflection: vec![0.0; 2 * layout.cranks * nd],
         };
         Self {
             channels: channels.to_vec(),
@@ -705,6 +721,7 @@ impl Recorder {
         if has(Channel::Bearings) {
             push("crank_bearing_force", &sink.crank_bearing);
             push("eccentric_bearing_force", &sink.eccentric_bearing);
+            push("crank_deflection", &sink.crank_deflection);
         }
         rec.samples += 1;
     }

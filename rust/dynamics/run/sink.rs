@@ -42,6 +42,9 @@ pub trait ContactSink {
     /// Bearing force \[N\] (fixed frame): `family` 0 = crank bearing `index` (force on the crank
     /// centre), 1 = eccentric bearing `index = crank * discs + disc` (force on the disc).
     fn bearing(&mut self, _family: usize, _index: usize, _force: [f64; 2]) {}
+    /// Deflection \[m\] (fixed frame) of a bending crank's eccentric from the crank's line,
+    /// `index = crank * discs + disc`.
+    fn crank_deflection(&mut self, _index: usize, _deflection: [f64; 2]) {}
 }
 
 /// The sink of the hot path: ignores everything.
@@ -92,5 +95,8 @@ impl ContactSink for DynSink<'_> {
     }
     fn bearing(&mut self, family: usize, index: usize, force: [f64; 2]) {
         self.0.bearing(family, index, force);
+    }
+    fn crank_deflection(&mut self, index: usize, deflection: [f64; 2]) {
+        self.0.crank_deflection(index, deflection);
     }
 }

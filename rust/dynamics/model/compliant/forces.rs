@@ -136,6 +136,7 @@ impl CompliantModel {
                     qf[ci + 1] += fk[1];
                     qf[ci + 2] += cross(eccs[k], fk);
                     out.potential += 0.5 * dot(u[k], fk);
+                    sink.crank_deflection(i * nd + k, u[k]);
                 }
             }
             // Sun/planet mesh i. The sun pushes planet i along w_i = sin(pa) u_i + cos(pa)
