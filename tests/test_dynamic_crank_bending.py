@@ -82,6 +82,23 @@ def test_eccentric_deflections_of_the_run_are_the_ltca_s(slow_run: tuple[Scene, 
     assert np.abs(run.crank_deflection[run.t.size // 2]).max() > 0.5 * scale
 
 
+def test_bending_stress_of_the_run_is_the_ltca_s(slow_run: tuple[Scene, rvdyn.Result]) -> None:
+    """``Result.crank_bending_stress()`` from the recorded eccentric bearing forces equals the
+    LTCA's at the same crank angles in the quasi-static run (measured 1.2e-6; asserted 1e-3:
+    the eccentrics' inertia it leaves out is negligible here); a run of straight cranks has no
+    shaft to load: ``ParameterError``."""
+    scene, run = slow_run
+    idx = np.arange(run.t.size - 5, run.t.size)
+    want = ltca(scene, RATED, -23.0 * run.sun_angle[idx] / scene.ratio).crank_bending_stress()
+    got = run.crank_bending_stress()[idx]
+    assert got.shape == (5, 3) and want.max() > 1e8
+    np.testing.assert_allclose(got, want, rtol=1e-3)
+    with pytest.raises(rvdyn.ParameterError, match="crank_shaft and crank_layout"):
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message=START_IMPACT, category=RuntimeWarning)
+            simulate(Scene.physical("rated"), 1e-3).crank_bending_stress()
+
+
 def test_energy_balance_closes_with_bending_cranks() -> None:
     """Input work = output work + kinetic (the eccentrics' too) + elastic (the shafts'
     bending too) + dissipated, from rest under the rated load: 1e-6 of the input work at

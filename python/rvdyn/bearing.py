@@ -123,6 +123,33 @@ class CrankLayout:
         return out
 
 
+def crank_bending_stress(scene: dict[str, Any], eccentric_bearing_force: ArrayLike, caller: str) -> NDArray[np.float64]:
+    """The largest nominal bending stress in each crankshaft [Pa], shape (..., cranks): the
+    shaft of ``scene``'s ``crank_shaft`` on its two bearings (``crank_layout``, simple
+    supports) under the forces on its eccentrics (minus ``eccentric_bearing_force``, shape
+    (..., cranks, discs, 2)), ``sigma = 32 |M| / (pi d^3)`` at the worst plane (the bending
+    moment is largest at a load or a support; docs/model.md, "Crankshaft bending"). Nominal: no
+    notch factor, no shear, no planet force. ``ParameterError`` (naming ``caller``) without
+    ``crank_shaft``."""
+    shaft, layout = scene.get("crank_shaft"), scene.get("crank_layout")
+    if not shaft or not layout:
+        raise ParameterError(f"{caller} needs a scene with crank_shaft and crank_layout "
+                             "(the shaft's diameter and the planes of its bearings and discs)")
+    za, zb = (float(z) for z in layout["bearings"])
+    zd = np.asarray(layout["discs"], dtype=float)
+    load = -np.asarray(eccentric_bearing_force, dtype=float)  # (..., cranks, discs, 2)
+    # Reactions from the balance of forces and of moments about bearing a.
+    rb = -np.einsum("...cka,k->...ca", load, zd - za) / (zb - za)
+    ra = -load.sum(axis=-2) - rb
+    planes = np.concatenate([[za, zb], zd])
+    forces = np.concatenate([ra[..., None, :], rb[..., None, :], load], axis=-2)  # (..., c, planes, 2)
+    # M(z) = sum over the forces left of z of F (z - z_j), at every plane.
+    lever = np.clip(planes[None, :] - planes[:, None], 0.0, None)  # [at, from]
+    moment = np.einsum("pj,...cja->...cpa", lever, forces)
+    d = float(shaft["diameter"])
+    return 32.0 * np.linalg.norm(moment, axis=-1).max(axis=-1) / (math.pi * d**3)  # type: ignore[no-any-return]
+
+
 def static_safety(caller: str, family: str, peak: float, static: float, remedy: str) -> float:
     """ISO 76 static safety ``s0 = C0r / P0`` of the ``family`` bearings (peak radial load
     ``peak`` [N], static rating ``static`` [N]; inf at no load), with a ``RuntimeWarning`` naming

@@ -322,6 +322,20 @@ class Result:
         return {name: float(np.mean(getattr(self, f"{name}_friction_power")[i0:]))
                 for name in ("pin", "mesh", "bearing")}
 
+    def crank_bending_stress(self) -> np.ndarray:
+        """The largest nominal bending stress in each crankshaft [Pa], shape (n, cranks), for a
+        scene with ``crank_shaft``: the shaft on its two bearings under the recorded
+        ``eccentric_bearing_force`` (the ``bearings`` channel), ``32 |M| / (pi d^3)`` at the
+        worst plane, as :meth:`rvdyn.analysis.LtcaResult.crank_bending_stress`. The eccentrics'
+        own inertia force (their mass times their acceleration, next to the bearing force) is
+        left out. ``ParameterError`` without ``crank_shaft`` or the ``bearings`` channel."""
+        from .bearing import crank_bending_stress
+
+        if "eccentric_bearing_force" not in self._arrays:
+            raise ParameterError("crank_bending_stress needs the bearings channel: "
+                                 "simulate(..., channels=[..., \"bearings\"])")
+        return crank_bending_stress(self.scene, self.eccentric_bearing_force, "crank_bending_stress")
+
     def bearing_life(self, t_start: float | None = None,
                      crank_layout: CrankLayout | None = None) -> dict[str, dict[str, float]]:
         """Peak and equivalent radial load [N], ISO 281 rating [N] and basic rating life

@@ -132,24 +132,10 @@ class LtcaResult:
         ``sigma = 32 |M| / (pi d^3)`` at the worst plane (the bending moment is largest at a
         load or a support; docs/model.md, "Crankshaft bending"). Nominal: no notch factor, no
         shear, no planet force. ``ParameterError`` without ``crank_shaft``."""
-        sc = self.scene or {}
-        shaft, layout = sc.get("crank_shaft"), sc.get("crank_layout")
-        if not shaft or not layout:
-            raise ParameterError("crank_bending_stress needs a scene with crank_shaft and crank_layout "
-                                 "(the shaft's diameter and the planes of its bearings and discs)")
-        za, zb = (float(z) for z in layout["bearings"])
-        zd = np.asarray(layout["discs"], dtype=float)
-        load = -np.asarray(self.arrays["eccentric_bearing_force"], dtype=float)  # (n, cranks, discs, 2)
-        # Reactions from the balance of forces and of moments about bearing a.
-        rb = -np.einsum("ncka,k->nca", load, zd - za) / (zb - za)
-        ra = -load.sum(axis=2) - rb
-        planes = np.concatenate([[za, zb], zd])
-        forces = np.concatenate([ra[:, :, None], rb[:, :, None], load], axis=2)  # (n, c, planes, 2)
-        # M(z) = sum over the forces left of z of F (z - z_j), at every plane.
-        lever = np.clip(planes[None, :] - planes[:, None], 0.0, None)  # [at, from]
-        moment = np.einsum("pj,ncja->ncpa", lever, forces)
-        d = float(shaft["diameter"])
-        return 32.0 * np.linalg.norm(moment, axis=-1).max(axis=-1) / (math.pi * d**3)  # type: ignore[no-any-return]
+        from ..bearing import crank_bending_stress
+
+        return crank_bending_stress(self.scene or {}, self.arrays["eccentric_bearing_force"],
+                                    "crank_bending_stress")
 
     def bearing_safety(self, crank_layout: CrankLayout | None = None) -> dict[str, dict[str, float]]:
         """ISO 76 static safety of the most loaded bearing of each family over these crank
