@@ -210,6 +210,8 @@ impl Linearizer {
         } else {
             None
         };
+        // The LTCA unknowns the linearisation keeps (all but the condensed deflections).
+        let kept = statics.dim() - nodes;
         let (mut names, mut mass, dynamic): (Vec<String>, Vec<f64>, Dynamic) = match scene.joints {
             Joints::Rigid => {
                 let m = RigidModel::new(&free_scene)?;
@@ -223,13 +225,12 @@ impl Linearizer {
             }
             Joints::Compliant { .. } => {
                 let m = CompliantModel::new(&free_scene)?;
-                let kept = &statics.unknowns[..statics.dim() - nodes];
-                let names = kept.iter().map(|&i| full[i].clone()).collect();
-                let mass = kept.iter().map(|&i| m.mass[i]).collect();
+                let unknowns = &statics.unknowns[..kept];
+                let names = unknowns.iter().map(|&i| full[i].clone()).collect();
+                let mass = unknowns.iter().map(|&i| m.mass[i]).collect();
                 (names, mass, Dynamic::Compliant(Box::new(m)))
             }
         };
-        let kept = statics.dim() - nodes;
         let mut dyn_index: Vec<usize> = match &dynamic {
             Dynamic::Rigid(_) => (0..kept).collect(),
             Dynamic::Compliant(_) => statics.unknowns[..kept].to_vec(),

@@ -68,17 +68,17 @@ impl CompliantModel {
             }
             // Eccentric bearings: force on the disc at H, opposite on the crank at E (or on the
             // eccentric's own centre when the crank bends, see below).
+            let mut eccs = [[0.0; 2]; MAX_BENDING_DISCS];
             for (k, disc) in m.discs.iter().enumerate() {
                 let dk = self.disc_index(k);
                 let (sa, ca) = (alpha + disc.phase + self.ecc_phase[i]).sin_cos();
                 let ecc = [self.ecc_radius[i] * ca, self.ecc_radius[i] * sa];
-                let mut e_pos = add(p, ecc);
-                let mut e_v = add(pv, scaled(va, perp(ecc)));
+                eccs[k] = ecc;
                 let node = self.bending.as_ref().map(|_| self.node_index(i, k));
-                if let Some(ni) = node {
-                    e_pos = [x[ni], x[ni + 1]];
-                    e_v = [v[ni], v[ni + 1]];
-                }
+                let (e_pos, e_v) = match node {
+                    Some(ni) => ([x[ni], x[ni + 1]], [v[ni], v[ni + 1]]),
+                    None => (add(p, ecc), add(pv, scaled(va, perp(ecc)))),
+                };
                 let o = [x[dk], x[dk + 1]];
                 let ov = [v[dk], v[dk + 1]];
                 let arm = rotate(x[dk + 2], self.holes[i * nd + k]);
@@ -115,12 +115,9 @@ impl CompliantModel {
             // the reaction goes to the crank at that point. No damping of its own.
             if let Some(bend) = &self.bending {
                 let mut u = [[0.0; 2]; MAX_BENDING_DISCS];
-                let mut eccs = [[0.0; 2]; MAX_BENDING_DISCS];
-                for (k, disc) in m.discs.iter().enumerate() {
-                    let (sa, ca) = (alpha + disc.phase + self.ecc_phase[i]).sin_cos();
-                    eccs[k] = [self.ecc_radius[i] * ca, self.ecc_radius[i] * sa];
+                for (k, uk) in u.iter_mut().enumerate().take(nd) {
                     let ni = self.node_index(i, k);
-                    u[k] = sub([x[ni], x[ni + 1]], add(p, eccs[k]));
+                    *uk = sub([x[ni], x[ni + 1]], add(p, eccs[k]));
                 }
                 for k in 0..nd {
                     let mut fk = [0.0; 2];

@@ -452,26 +452,22 @@ impl CompliantModel {
             let mut o = [0.0; 2];
             for i in 0..self.cranks {
                 let (s, c) = (d.phase + self.ecc_phase[i]).sin_cos();
-                let e_pos = add(self.seat_vecs[i], scaled(self.ecc_radius[i], [c, s]));
+                let ecc = scaled(self.ecc_radius[i], [c, s]);
+                let e_pos = add(self.seat_vecs[i], ecc);
                 let h = rotate(d.angle_offset, self.holes[i * nd + k]);
                 o = add(o, scaled(1.0 / self.cranks as f64, sub(e_pos, h)));
-            }
-            let ov = scaled(wa, perp(o));
-            x[dk..dk + 3].copy_from_slice(&[o[0], o[1], d.angle_offset]);
-            v[dk..dk + 3].copy_from_slice(&[ov[0], ov[1], wc]);
-            if self.bending.is_some() {
-                // Straight cranks: each eccentric centre on its crank.
-                for i in 0..self.cranks {
+                if self.bending.is_some() {
+                    // Straight cranks: each eccentric centre on its crank.
                     let ci = crank_index(i);
-                    let (s, c) = (d.phase + self.ecc_phase[i]).sin_cos();
-                    let ecc = scaled(self.ecc_radius[i], [c, s]);
-                    let e_pos = add([x[ci], x[ci + 1]], ecc);
-                    let e_v = add([v[ci], v[ci + 1]], scaled(v[ci + 2], perp(ecc)));
+                    let e_v = add([v[ci], v[ci + 1]], scaled(wa, perp(ecc)));
                     let ni = self.node_index(i, k);
                     x[ni..ni + 2].copy_from_slice(&e_pos);
                     v[ni..ni + 2].copy_from_slice(&e_v);
                 }
             }
+            let ov = scaled(wa, perp(o));
+            x[dk..dk + 3].copy_from_slice(&[o[0], o[1], d.angle_offset]);
+            v[dk..dk + 3].copy_from_slice(&[ov[0], ov[1], wc]);
         }
         if let Some(li) = self.load_index {
             v[li] = v[CARRIER];
