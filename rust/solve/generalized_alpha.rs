@@ -42,6 +42,13 @@ use nalgebra::{DMatrix, DVector};
 pub const NEWTON_KAPPA: f64 = 0.003;
 /// ... but never looser than this multiple of the Newton tolerance `atol`.
 pub const NEWTON_LOOSEST: f64 = 10.0;
+/// A step whose Newton iteration contracts slower than this counts its iterations beyond the
+/// first against the cost of a new Jacobian (see `GeneralizedAlpha::stale_iterations`); a
+/// fresh finite-difference Jacobian gives about 0.005 on the rated paper scene at dt 1e-3 s, a
+/// stale one 0.03-0.2 (BENCHMARKS.md section 3, "Newton checked by the sample").
+pub const THETA_STALE: f64 = 0.1;
+/// Contraction above which the Jacobian is refreshed at once (Newton barely converges).
+pub const THETA_SLOW: f64 = 0.3;
 
 /// Registry entry of generalized-alpha.
 pub static ENTRY: IntegratorEntry = IntegratorEntry {
@@ -72,6 +79,34 @@ pub struct Attempt {
     /// Largest contraction factor of the Newton iteration of this step, over increments above
     /// the Newton tolerance (0 if none was measured).
     pub theta: f64,
+    /// `Some(size)` if the step ended after Newton's first increment (of `size`, in
+    /// displacement at the levers \[m\]) without a measured contraction, its check left to
+    /// [`GeneralizedAlpha::confirm`] (only with `provisional_ok`).
+    pub provisional: Option<f64>,
+}
+
+/// A step accepted after Newton's first increment, awaiting [`GeneralizedAlpha::confirm`]:
+/// the state at its start, the start's pseudo-acceleration (rescaled to the step), the size of
+/// that increment and the step.
+#[derive(Debug)]
+struct Held {
+    old: State,
+    p0: Vec<f64>,
+    size: f64,
+    h: f64,
+    /// The pseudo-acceleration as it was before the step (`p`, `p_t`, `p_h`), for a step taken
+    /// again from its start.
+    p_before: (Vec<f64>, f64, f64),
+}
+
+/// Where a Newton iteration resumes: an evaluation at the current iterate made by someone
+/// else (the accelerations `f`), and the size of the increment that led to it.
+struct Resume<'a> {
+    f: &'a [f64],
+    previous_size: f64,
+    /// Whether the evaluated iterate should stand if it is within the tolerance (the caller
+    /// keeps its evaluation); otherwise the increment is applied as in any iteration.
+    keep: bool,
 }
 
 /// The vectors of one Newton iteration: the start's pseudo-acceleration, the end's
@@ -124,12 +159,37 @@ pub struct GeneralizedAlpha {
     theta: f64,
     /// Steps accepted after one iteration since theta was last measured.
     unmeasured: u32,
+    /// Newton iterations beyond the first, on steps that contracted slower than
+    /// [`THETA_STALE`], since the last Jacobian. When they reach `stale_budget` the next step
+    /// takes a new Jacobian: the stale one has then cost as many evaluations as a new one
+    /// (the rent-or-buy rule; Karlin et al., Competitive randomized algorithms for
+    /// nonuniform problems, Algorithmica 11, 1994, spend at most twice the best choice).
+    stale_iterations: u64,
+    /// Stale iterations that buy a new Jacobian: its cost in evaluations (`1 + 2 n`),
+    /// multiplied by 4 each time a new one did not contract at least twice as fast (the
+    /// contraction is then the forces' nonlinearity, which no Jacobian removes).
+    stale_budget: u64,
+    /// The contraction that last bought a Jacobian (NaN: none awaiting its verdict).
+    theta_bought: f64,
+    /// Whether a step may end after Newton's first increment without a measured contraction,
+    /// leaving its check to [`GeneralizedAlpha::confirm`] with an evaluation the caller makes
+    /// at the step end anyway (a recorded sample).
+    pub provisional_ok: bool,
+    /// The step last accepted provisionally: what `confirm` needs to continue its Newton
+    /// iteration.
+    held: Option<Held>,
+    /// Whether `confirm` moved the state (the step's end was not within the tolerance).
+    moved: bool,
+    /// Scratch of `confirm`: the iterate it checks.
+    kept: Vec<f64>,
     /// Jacobians computed (and factored).
     pub jacobians: u64,
     /// Newton iterations, all steps.
     pub newton_iterations: u64,
     /// Steps split in halves because Newton stalled.
     pub splits: u64,
+    /// Provisional steps taken again from their start because their check's iteration failed.
+    pub redone: u64,
     /// Force evaluations, Jacobians included.
     pub evaluations: u64,
     /// Vectors of accepted steps' old states and pseudo-accelerations, reused by the next
@@ -176,9 +236,17 @@ impl GeneralizedAlpha {
             p_h: f64::NAN,
             theta: 1.0,
             unmeasured: 0,
+            stale_iterations: 0,
+            stale_budget: 0,
+            theta_bought: f64::NAN,
+            provisional_ok: false,
+            held: None,
+            moved: false,
+            kept: Vec::new(),
             jacobians: 0,
             newton_iterations: 0,
             splits: 0,
+            redone: 0,
             evaluations: 0,
             spare: Vec::new(),
             f: Vec::new(),
@@ -222,16 +290,30 @@ impl GeneralizedAlpha {
         h: f64,
         depth: u32,
     ) -> Result<()> {
+        if self.held.is_some() {
+            // Nobody checked the last step: check it before going on from it.
+            self.confirm(sys, st, None)?;
+        }
         // Only a step taken whole leaves its power flows to the caller: the caller sees the
         // whole step's ends, not the inner ends of a split one.
         self.defer_now = self.track_work && self.defer_work && depth == 0;
         self.pending = None;
-        match self.attempt(sys, st, h) {
+        // A provisional end is checked by an evaluation there, so only a whole step may
+        // have one, and only if nobody evaluates the step end's power flows before the check.
+        let provisional_ok = self.provisional_ok;
+        self.provisional_ok &= depth == 0 && (!self.track_work || self.defer_now);
+        let outcome = self.attempt(sys, st, h);
+        self.provisional_ok = provisional_ok;
+        match outcome {
             Ok(Some(a)) => {
                 if self.defer_now {
                     self.pending = Some(h);
                 }
-                self.accept(st, a);
+                if let Some(size) = a.provisional {
+                    self.hold(st, a, size);
+                } else {
+                    self.accept(st, a);
+                }
                 Ok(())
             }
             Ok(None) | Err(_) if depth < 10 => {
@@ -247,6 +329,152 @@ impl GeneralizedAlpha {
             ))),
             Err(e) => Err(e),
         }
+    }
+
+    /// As [`GeneralizedAlpha::accept`] for a provisional `a`, keeping what
+    /// [`GeneralizedAlpha::confirm`] needs.
+    fn hold(&mut self, st: &mut State, a: Attempt, size: f64) {
+        let old_p = std::mem::replace(&mut self.p, a.p1);
+        let p_before = (old_p, self.p_t, self.p_h);
+        self.p_t = a.next.t;
+        self.p_h = a.h;
+        let old = std::mem::replace(st, a.next);
+        self.held = Some(Held {
+            old,
+            p0: a.p0,
+            size,
+            h: a.h,
+            p_before,
+        });
+    }
+
+    /// Whether the last step ended provisionally: [`GeneralizedAlpha::confirm`] must check it
+    /// before the state is used (the next `step` does so itself if nobody did).
+    pub fn provisional(&self) -> bool {
+        self.held.is_some()
+    }
+
+    /// Check a provisional step end `st` with the accelerations `f_end` evaluated there (by a
+    /// caller that evaluates the state anyway), or with an evaluation of its own (`None`).
+    /// Newton's next increment is computed from it: if it is within the tolerance the state
+    /// stands (`Ok(true)`); otherwise the iteration goes on from it as it would have, and `st`
+    /// becomes its result (`Ok(false)`: what was evaluated at the old `st` is void). A step
+    /// whose iteration then fails is taken again from its start, as an unconverged step is.
+    pub fn confirm<S: MechanicalSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        st: &mut State,
+        f_end: Option<&[f64]>,
+    ) -> Result<bool> {
+        let Some(held) = self.held.take() else {
+            return Ok(true);
+        };
+        let n = st.q.len();
+        let Held {
+            old,
+            p0,
+            size,
+            h,
+            p_before,
+        } = held;
+        // The caller's evaluation, or one of our own (an iterate that failed to evaluate is
+        // a step whose Newton failed).
+        let mut own = None;
+        if f_end.is_none_or(|f| f.len() != n) {
+            let mut f = self.take(n);
+            let mut power = st.power;
+            self.evaluations += 1;
+            if sys.eval(st.t, &st.q, &st.v, &mut f, &mut power).is_err() {
+                self.give(f);
+                self.give(p0);
+                return self.redo(sys, st, old, p_before, h);
+            }
+            own = Some(f);
+        }
+        let (f_end, keep) = match (&own, f_end) {
+            (Some(f), _) => (&f[..], false),
+            (None, Some(f)) => (f, true),
+            (None, None) => unreachable!("an evaluation is given or made"),
+        };
+        let mut a1 = self.take(n);
+        a1.copy_from_slice(&st.a);
+        let (p1, q1, v1) = (self.take(n), self.take(n), self.take(n));
+        let mut f = std::mem::take(&mut self.f);
+        f.resize(n, 0.0);
+        let mut r = std::mem::replace(&mut self.residual, DVector::zeros(0));
+        if r.len() != n {
+            r = DVector::zeros(n);
+        }
+        self.moved = false;
+        let outcome = self.iterate(
+            sys,
+            &old,
+            h,
+            Vectors {
+                p0,
+                a1,
+                p1,
+                q1,
+                v1,
+                f: &mut f,
+                r: &mut r,
+            },
+            Some(Resume {
+                f: f_end,
+                previous_size: size,
+                keep,
+            }),
+        );
+        self.f = f;
+        self.residual = r;
+        if let Some(f) = own {
+            self.give(f);
+        }
+        match outcome {
+            Ok(Some(a)) => {
+                self.give(p_before.0);
+                let moved = self.moved;
+                // The pseudo-acceleration at `st` is replaced by the confirmed one (the same
+                // numbers when the state stands).
+                let old_p = std::mem::replace(&mut self.p, a.p1);
+                self.p_t = a.next.t;
+                self.p_h = a.h;
+                let was = std::mem::replace(st, a.next);
+                for v in [old_p, a.p0, was.q, was.v, was.a, old.q, old.v, old.a] {
+                    self.give(v);
+                }
+                Ok(!moved)
+            }
+            Ok(None) | Err(_) => self.redo(sys, st, old, p_before, h),
+        }
+    }
+
+    /// Take a provisional step that failed its check again from its start `old` (with the
+    /// pseudo-acceleration as it was, `p_before`), with a new Jacobian and without a
+    /// provisional end, as a step whose Newton fails. `Ok(false)`: the state moved.
+    fn redo<S: MechanicalSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        st: &mut State,
+        old: State,
+        p_before: (Vec<f64>, f64, f64),
+        h: f64,
+    ) -> Result<bool> {
+        let (p, p_t, p_h) = p_before;
+        let p = std::mem::replace(&mut self.p, p);
+        self.give(p);
+        self.p_t = p_t;
+        self.p_h = p_h;
+        let was = std::mem::replace(st, old);
+        for v in [was.q, was.v, was.a] {
+            self.give(v);
+        }
+        self.stiffness = None;
+        self.redone += 1;
+        let provisional_ok = std::mem::replace(&mut self.provisional_ok, false);
+        let redo = self.advance(sys, st, h, 0);
+        self.provisional_ok = provisional_ok;
+        redo.map(|()| false)
     }
 
     /// Make `a` the state: its pseudo-acceleration becomes the start of the next step.
@@ -348,6 +576,7 @@ impl GeneralizedAlpha {
                 f: &mut f,
                 r: &mut r,
             },
+            None,
         );
         self.f = f;
         self.residual = r;
@@ -361,6 +590,7 @@ impl GeneralizedAlpha {
         st: &State,
         h: f64,
         vectors: Vectors<'_>,
+        resume: Option<Resume<'_>>,
     ) -> Result<Option<Attempt>> {
         let Vectors {
             p0,
@@ -378,6 +608,9 @@ impl GeneralizedAlpha {
         let dq_da = beta * h * h * (1.0 - alpha_f) / (1.0 - alpha_m);
         let mut power = [0.0; 3];
         let t1 = st.t + h;
+        // A resumed iteration keeps its first iterate here.
+        let mut kept = std::mem::take(&mut self.kept);
+        kept.resize(n, 0.0);
         let Some(lu) = self.lu.as_ref() else {
             return Ok(None);
         };
@@ -389,14 +622,24 @@ impl GeneralizedAlpha {
                 v1[i] = st.v[i] + h * ((1.0 - gamma) * p0[i] + gamma * p1[i]);
             }
         };
-        let mut previous_size = f64::NAN;
+        let mut previous_size = resume.as_ref().map_or(f64::NAN, |r| r.previous_size);
         // Contraction of this step's iteration, measured only on increments above the
         // tolerance (below it their ratio is round-off).
         let mut theta_step: f64 = 0.0;
-        for iteration in 0..self.max_newton {
-            update(&a1, &mut p1, &mut q1, &mut v1);
-            sys.eval(t1, &q1, &v1, f, &mut power)?;
-            self.evaluations += 1;
+        // A resumed iteration is at its second iterate, evaluated by the caller.
+        let start = u32::from(resume.is_some());
+
+        for iteration in start..self.max_newton {
+            let resumed = iteration == start && resume.is_some();
+            if let (true, Some(rs)) = (resumed, resume.as_ref()) {
+                f.copy_from_slice(rs.f);
+                // The iterate as it was: it stands if its increment is within the tolerance.
+                kept.copy_from_slice(&a1);
+            } else {
+                update(&a1, &mut p1, &mut q1, &mut v1);
+                sys.eval(t1, &q1, &v1, f, &mut power)?;
+                self.evaluations += 1;
+            }
             self.newton_iterations += 1;
             for i in 0..n {
                 r[i] = a1[i] - f[i];
@@ -444,14 +687,45 @@ impl GeneralizedAlpha {
             } else {
                 f64::INFINITY
             };
-            if remaining < tol || (iteration > 0 && size < 1e-3 * tol) {
-                if iteration == 0 {
+            // The evaluated iterate of a resumed iteration stands when its own increment is
+            // within the tolerance (the caller's evaluation then stays valid).
+            let stands = resumed && resume.as_ref().is_some_and(|r| r.keep) && size < tol;
+            // A step may end provisionally after its first increment when a check is sure to
+            // follow (`provisional_ok`): it costs the evaluation the next iteration would make.
+            let provisional =
+                resume.is_none() && iteration == 0 && self.provisional_ok && remaining >= tol;
+            if remaining < tol || (iteration > 0 && size < 1e-3 * tol) || stands || provisional {
+                if stands {
+                    a1.copy_from_slice(&kept);
+                }
+                self.kept = kept;
+                if resumed {
+                    self.moved = !stands;
+                }
+                if provisional {
+                } else if iteration == 0 {
                     self.unmeasured += 1;
                 } else {
                     self.unmeasured = 0;
-                    if self.theta > 0.3 {
+                    if self.theta > THETA_SLOW {
                         // Slow contraction: the reused Jacobian is stale; refresh it next step.
                         self.stiffness = None;
+                    }
+                    if !self.theta_bought.is_nan() && theta_step > 0.0 {
+                        let cost = 1 + 2 * n as u64;
+                        self.stale_budget = if theta_step > 0.5 * self.theta_bought {
+                            (self.stale_budget.max(cost) * 4).min(1 << 20)
+                        } else {
+                            cost
+                        };
+                        self.theta_bought = f64::NAN;
+                    }
+                    if theta_step > THETA_STALE && theta_step <= THETA_SLOW {
+                        self.stale_iterations += u64::from(iteration);
+                        if self.stale_iterations >= self.stale_budget.max(1 + 2 * n as u64) {
+                            self.stiffness = None;
+                            self.theta_bought = theta_step;
+                        }
                     }
                 }
                 update(&a1, &mut p1, &mut q1, &mut v1);
@@ -477,6 +751,7 @@ impl GeneralizedAlpha {
                     p1,
                     h,
                     theta: theta_step,
+                    provisional: provisional.then_some(size),
                 }));
             }
         }
@@ -495,6 +770,7 @@ impl GeneralizedAlpha {
             }
         })?;
         self.jacobians += 1;
+        self.stale_iterations = 0;
         self.stiffness = Some((kq, kv));
         self.lu = None;
         self.theta = 1.0;
@@ -536,6 +812,31 @@ impl Integrator for GeneralizedAlphaRun {
     fn defer_step_power(&mut self) -> bool {
         self.stepper.defer_work = true;
         true
+    }
+
+    fn check_with_samples(&mut self) -> bool {
+        self.stepper.provisional_ok = true;
+        true
+    }
+
+    fn provisional(&self) -> bool {
+        self.stepper.provisional()
+    }
+
+    fn confirm(
+        &mut self,
+        sys: &dyn MechanicalSystem,
+        st: &mut State,
+        f_end: Option<&[f64]>,
+    ) -> Result<bool> {
+        let t = st.t;
+        let stands = self.stepper.confirm(sys, st, f_end)?;
+        // A step taken again from its start ends at the clock's time again.
+        if st.t != t {
+            self.stepper.retime(st.t, t);
+            st.t = t;
+        }
+        Ok(stands)
     }
 
     fn pending_work(&self) -> Option<f64> {

@@ -116,6 +116,29 @@ pub trait Integrator: Send {
     fn pending_work(&self) -> Option<f64> {
         None
     }
+    /// Offer to check each step end with an evaluation the caller makes there anyway (a
+    /// recorded sample); `true` if the integrator may from now on end a step provisionally
+    /// (see [`Integrator::provisional`]). The default integrator does not.
+    fn check_with_samples(&mut self) -> bool {
+        false
+    }
+    /// After [`Integrator::advance`]: whether the step ended provisionally. The caller must
+    /// then call [`Integrator::confirm`] before it uses the state.
+    fn provisional(&self) -> bool {
+        false
+    }
+    /// Check a provisional step end `st` with the accelerations `f_end` (free coordinates, as
+    /// `MechanicalSystem::eval` gives them) evaluated at it, or with an evaluation of the
+    /// integrator's own (`None`). `Ok(true)`: the state stands and the caller's evaluation
+    /// is valid; `Ok(false)`: `st` was moved (the caller evaluates again).
+    fn confirm(
+        &mut self,
+        _sys: &dyn MechanicalSystem,
+        _st: &mut State,
+        _f_end: Option<&[f64]>,
+    ) -> Result<bool> {
+        Ok(true)
+    }
 }
 
 /// A registered integrator: its names, default step and constructor.

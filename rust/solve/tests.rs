@@ -299,6 +299,42 @@ fn newton_stopped_at_the_local_error_keeps_the_accuracy() {
     assert!(it_loose < it_strict, "{it_loose} >= {it_strict}");
 }
 
+/// A step ended provisionally after Newton's first increment and checked by an evaluation
+/// at its end (`confirm` with its own evaluation) is the same iteration as a step that
+/// iterates on: the same iterates, tests and Jacobians, so the same trajectory bit for bit,
+/// including the steps whose iteration fails and is taken again (the pressed Hertzian
+/// contact from rest at 5e-4 s steps, 0.3 of its period, where Newton with the reused
+/// Jacobian often diverges and steps are split; `redone` counts the provisional steps taken
+/// again, and the test fails if none is).
+#[test]
+fn a_provisional_step_checked_at_its_end_is_the_same_step() {
+    let sys = Hertzian { scale: [1.0] };
+    let run = |provisional: bool| {
+        let mut st = State::new(&sys, 0.0, vec![0.0], vec![0.0]).unwrap();
+        let mut ga = GeneralizedAlpha::new(0.8, 1e-12, false).unwrap();
+        ga.provisional_ok = provisional;
+        let mut path = Vec::new();
+        let mut held = 0;
+        for _ in 0..200 {
+            ga.step(&sys, &mut st, 5e-4).unwrap();
+            if ga.provisional() {
+                held += 1;
+                ga.confirm(&sys, &mut st, None).unwrap();
+            }
+            assert!(!ga.provisional());
+            path.push((st.q[0], st.v[0], st.a[0]));
+        }
+        (path, held, ga.redone, ga.newton_iterations)
+    };
+    let (plain, held_plain, _, it_plain) = run(false);
+    let (checked, held, redone, it_checked) = run(true);
+    assert_eq!(held_plain, 0);
+    assert!(held > 100, "only {held} provisional steps");
+    assert!(redone > 0, "no provisional step failed its check");
+    assert_eq!(plain, checked);
+    assert!(it_checked >= it_plain);
+}
+
 /// The adaptive methods' next step lands on the end time without a sliver: a step over half
 /// of what remains becomes half of it, one at or past the end becomes the rest, and `h_max`
 /// caps the proposal.

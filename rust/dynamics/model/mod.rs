@@ -75,6 +75,10 @@ pub struct Observation {
     /// Power flows `[input, output, dissipated]` \[W\], as `MechanicalSystem::eval` gives them
     /// at this state (zero when the sink wants no forces).
     pub power: [f64; 3],
+    /// Accelerations of the free coordinates `Q / M` (`ReducerModel::initial_state` order),
+    /// as `MechanicalSystem::eval` gives them at this state (empty when the sink wants no
+    /// forces): an integrator can check its step end with them.
+    pub acceleration: Vec<f64>,
 }
 
 /// A reducer model the driver can integrate and record.

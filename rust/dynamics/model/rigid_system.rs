@@ -264,6 +264,14 @@ impl ReducerModel for RigidSystem<'_> {
                 sink.bearing(0, i, *r);
             }
         }
+        // As `eval` computes them (the same coordinates and operations).
+        let acceleration = if !sink.wants_forces() {
+            Vec::new()
+        } else if m.output_shaft.is_none() && m.input_shaft.is_none() {
+            m.free.iter().map(|&i| qa[i] / m.mass[i]).collect()
+        } else {
+            self.coords.iter().map(|&i| qa[i] / m.mass[i]).collect()
+        };
         let crank = x[CRANK].sin_cos();
         let (centres, angles): (Vec<[f64; 2]>, Vec<f64>) = m
             .discs
@@ -311,6 +319,7 @@ impl ReducerModel for RigidSystem<'_> {
             } else {
                 [0.0; 3]
             },
+            acceleration,
         })
     }
 }

@@ -654,6 +654,9 @@ pub fn run_with<M: ReducerModel>(
     // With the energy channel, generalized-alpha leaves the power flows at each step end to
     // this loop: a sample at the step end evaluates the forces there anyway.
     let deferred = opt.channels.contains(&Channel::Energy) && integrator.defer_step_power();
+    // A sample that evaluates the forces at a step end can check the step's Newton iteration
+    // there (generalized-alpha): the step then needs one evaluation fewer.
+    let checked = rec.wants_forces() && integrator.check_with_samples();
     // Force evaluations of this loop for the integrator (counted with its own).
     let mut own_evaluations = 0u64;
     let mut scratch = if deferred {
@@ -676,6 +679,27 @@ pub fn run_with<M: ReducerModel>(
         }
         copy_state(&mut prev, &st);
         integrator.advance(sys, &mut st, opt.t_end)?;
+        // An observation of the step end already made (and valid) for the sample due there.
+        let mut end_obs = None;
+        if integrator.provisional() {
+            let ts = next_sample as f64 * interval;
+            let due = checked
+                && next_sample < n_samples
+                && ts <= st.t + slack
+                && at_step_end(&prev, &st, ts)
+                && st.q.iter().chain(&st.v).all(|v| v.is_finite());
+            if due {
+                let obs = rec.observe(sys, st.t, &st.q, &st.v)?;
+                if integrator.confirm(sys, &mut st, Some(&obs.acceleration))? {
+                    end_obs = Some(obs);
+                } else {
+                    // The state moved: that evaluation served the integrator only.
+                    own_evaluations += 1;
+                }
+            } else {
+                integrator.confirm(sys, &mut st, None)?;
+            }
+        }
         if !st.q.iter().chain(&st.v).all(|v| v.is_finite()) {
             return Err(RvdynError::Simulation(format!(
                 "the state became non-finite at t = {:.6e} s; reduce the step or use the \
@@ -699,8 +723,13 @@ pub fn run_with<M: ReducerModel>(
                 }
             };
             if only_at_end {
-                let s = prev.interpolate(&st, ts);
-                let obs = rec.observe(sys, s.t, &s.q, &s.v)?;
+                let obs = match end_obs.take() {
+                    Some(obs) => obs,
+                    None => {
+                        let s = prev.interpolate(&st, ts);
+                        rec.observe(sys, s.t, &s.q, &s.v)?
+                    }
+                };
                 complete(&mut st, obs.power);
                 let work = prev.interpolate(&st, ts).work;
                 rec.push_observed(ts, &obs, work);
@@ -717,7 +746,9 @@ pub fn run_with<M: ReducerModel>(
             if ts > st.t + slack {
                 break;
             }
-            if at_step_end(&prev, &st, ts) {
+            if let Some(obs) = end_obs.take().filter(|_| at_step_end(&prev, &st, ts)) {
+                rec.push_observed(ts, &obs, st.work);
+            } else if at_step_end(&prev, &st, ts) {
                 // What the interpolation gives there (its weights are 0 and 1), without a copy.
                 rec.sample(sys, ts, &st.q, &st.v, st.work)?;
             } else {
@@ -776,6 +807,7 @@ mod tests {
 
     /// An integrator as it is, except that it keeps its own end-of-step power flows (the
     /// default `defer_step_power`): the recording before the driver took them from the samples.
+    /// It never ends a step provisionally (the default `check_with_samples`).
     struct OwnWork(Box<dyn Integrator>);
 
     impl Integrator for OwnWork {
@@ -784,6 +816,25 @@ mod tests {
         }
         fn stats(&self) -> Stats {
             self.0.stats()
+        }
+    }
+
+    /// An integrator as it is, except that it never ends a step provisionally (the
+    /// default `check_with_samples`): the recording before the samples checked Newton.
+    struct Unchecked(Box<dyn Integrator>);
+
+    impl Integrator for Unchecked {
+        fn advance(&mut self, sys: &dyn MechanicalSystem, st: &mut State, t: f64) -> Result<()> {
+            self.0.advance(sys, st, t)
+        }
+        fn stats(&self) -> Stats {
+            self.0.stats()
+        }
+        fn defer_step_power(&mut self) -> bool {
+            self.0.defer_step_power()
+        }
+        fn pending_work(&self) -> Option<f64> {
+            self.0.pending_work()
         }
     }
 
@@ -860,7 +911,7 @@ mod tests {
                 .map(|&defer| {
                     let integrator = opt.method.build(&opt.settings()).unwrap();
                     let integrator: Box<dyn Integrator> = if defer {
-                        integrator
+                        Box::new(Unchecked(integrator))
                     } else {
                         Box::new(OwnWork(integrator))
                     };

@@ -622,6 +622,11 @@ impl Recorder {
         Ok(())
     }
 
+    /// Whether a sample evaluates the forces (its observation then carries the accelerations).
+    pub fn wants_forces(&self) -> bool {
+        self.sink.forces
+    }
+
     /// The first half of [`Recorder::sample`]: evaluate the state `(q, v)` at `t` into the
     /// sample buffers; the observation's power flows can then serve the work integral before
     /// [`Recorder::push_observed`] records the sample.

@@ -752,6 +752,8 @@ impl ReducerModel for CompliantModel {
                 m.load.torque(t) * xv[self.load_index.unwrap_or(CARRIER)],
                 flows.dissipation,
             ],
+            // As `eval`.
+            acceleration: self.coords.iter().map(|&i| qf[i] / self.mass[i]).collect(),
         })
     }
 }
