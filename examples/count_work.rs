@@ -11,7 +11,8 @@
 //! `run T METHOD JOINTS [record|-] [ATOL RTOL]`: `dynamics::simulate` of the rated default
 //! scene for T s with no channels recorded (JOINTS `rigid`, `compliant`, or `physical` for the
 //! physical preset), or with `record` the default channels at every step, or with `goal=DT`
-//! benches/speed_goal.py's run at the step DT (motion and pins every 1 ms); `rhs N`: N force evaluations of the
+//! benches/speed_goal.py's run at the step DT (motion and pins every 1 ms; `checked=DT` the same
+//! with Newton checked by the samples); `rhs N`: N force evaluations of the
 //! rigid rated scene at one loaded state (after 0.05 s from rest); `phys N`: N force evaluations of
 //! the physical rated preset (compliant roller bearings) at one loaded state (after 0.1 s from
 //! rest).
@@ -76,11 +77,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let (Ok(atol), Ok(rtol)) = (arg(6, "").parse::<f64>(), arg(7, "").parse::<f64>()) {
         (opt.atol, opt.rtol) = (atol, rtol);
     }
-    if arg(5, "") == "record" {
+    let a5 = arg(5, "");
+    if a5 == "record" {
         // The default channels at every step (record interval = the step).
         opt.record_interval = Some(SimOptions::default_dt(method));
-    } else if let Some(dt) = arg(5, "").strip_prefix("goal=") {
-        // benches/speed_goal.py's run: step dt, motion and pins every 1 ms.
+    } else if let Some(dt) = a5
+        .strip_prefix("goal=")
+        .or_else(|| a5.strip_prefix("checked="))
+    {
+        // benches/speed_goal.py's run: step dt, motion and pins every 1 ms (`checked=DT`: with
+        // Newton checked by the samples, SimOptions::check_with_samples).
+        opt.check_with_samples = a5.starts_with("checked=");
         opt.dt = Some(dt.parse()?);
         opt.record_interval = Some(1e-3);
         opt.channels = vec![Channel::Motion, Channel::Pins];

@@ -303,8 +303,8 @@ class Result:
 
     def _check_window_balance(self, i0: int, w_in: float, w_out: float) -> None:
         # The residual E - E0 - W_in + W_out + D over the window bounds the integrator's error in
-        # the loss W_in - W_out: 1e-6 of it in sound runs, the whole loss when generalized-alpha
-        # at rho_inf 0.8 meets heavy damping (docs/model.md, "Efficiency and the energy balance").
+        # the loss W_in - W_out: 1e-6 of it in sound runs, the whole loss when a loose
+        # integrator meets heavy damping (docs/model.md, "Efficiency and the energy balance").
         drift = abs(float(self.energy_residual[-1] - self.energy_residual[i0]))
         loss = abs(w_in - w_out)
         if drift > EFFICIENCY_BALANCE_SHARE * loss and drift > EFFICIENCY_BALANCE_FLOOR * abs(w_in):

@@ -29,6 +29,7 @@
 //! and "Newton tolerance of generalized-alpha".
 
 use crate::error::{Result, RvdynError};
+use crate::solve::dopri5::VELOCITY_ERROR_TIME;
 use crate::solve::integrator::{FixedClock, Integrator, IntegratorEntry, Settings, Stats};
 use crate::solve::jacobian;
 use crate::solve::system::{MechanicalSystem, State};
@@ -688,8 +689,13 @@ impl GeneralizedAlpha {
                 f64::INFINITY
             };
             // The evaluated iterate of a resumed iteration stands when its own increment is
-            // within the tolerance (the caller's evaluation then stays valid).
-            let stands = resumed && resume.as_ref().is_some_and(|r| r.keep) && size < tol;
+            // within the tolerance (the caller's evaluation then stays valid), in displacement
+            // and in the displacement its velocity change makes in VELOCITY_ERROR_TIME (the
+            // error norm of the adaptive methods): Hairer's test leaves theta times less, and
+            // a heavily damped contact feels the velocity error.
+            let stands = resumed
+                && resume.as_ref().is_some_and(|r| r.keep)
+                && size * (gamma * VELOCITY_ERROR_TIME / (beta * h)).max(1.0) < tol;
             // A step may end provisionally after its first increment when a check is sure to
             // follow (`provisional_ok`): it costs the evaluation the next iteration would make.
             let provisional =
