@@ -392,42 +392,23 @@ impl GeneralizedAlpha {
             }
             own = Some(f);
         }
-        let (f_end, keep) = match (&own, f_end) {
-            (Some(f), _) => (&f[..], false),
-            (None, Some(f)) => (f, true),
-            (None, None) => unreachable!("an evaluation is given or made"),
+        let (f_end, keep) = match own.as_deref() {
+            Some(f) => (f, false),
+            None => (f_end.unwrap_or_default(), true),
         };
-        let mut a1 = self.take(n);
-        a1.copy_from_slice(&st.a);
-        let (p1, q1, v1) = (self.take(n), self.take(n), self.take(n));
-        let mut f = std::mem::take(&mut self.f);
-        f.resize(n, 0.0);
-        let mut r = std::mem::replace(&mut self.residual, DVector::zeros(0));
-        if r.len() != n {
-            r = DVector::zeros(n);
-        }
         self.moved = false;
-        let outcome = self.iterate(
+        let outcome = self.iterate_from(
             sys,
             &old,
             h,
-            Vectors {
-                p0,
-                a1,
-                p1,
-                q1,
-                v1,
-                f: &mut f,
-                r: &mut r,
-            },
+            p0,
+            &st.a,
             Some(Resume {
                 f: f_end,
                 previous_size: size,
                 keep,
             }),
         );
-        self.f = f;
-        self.residual = r;
         if let Some(f) = own {
             self.give(f);
         }
@@ -547,17 +528,30 @@ impl GeneralizedAlpha {
         st: &State,
         h: f64,
     ) -> Result<Option<Attempt>> {
-        let n = st.q.len();
         let p0 = self.p0(st, h);
         // Start from the old acceleration: the first increment then measures the change over
         // the step, and accepting only a small increment keeps small steps accurate (a
         // predictor that starts closer lets the displacement test, which scales with h^2,
         // accept a poorly converged acceleration at small h).
+        self.iterate_from(sys, st, h, p0, &st.a, None)
+    }
+
+    /// [`GeneralizedAlpha::iterate`] from the step start `st` with the start's
+    /// pseudo-acceleration `p0` and the end's acceleration `a1` first set to `a1_start`, with
+    /// vectors from the pool and the kept scratch.
+    fn iterate_from<S: MechanicalSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        st: &State,
+        h: f64,
+        p0: Vec<f64>,
+        a1_start: &[f64],
+        resume: Option<Resume<'_>>,
+    ) -> Result<Option<Attempt>> {
+        let n = st.q.len();
         let mut a1 = self.take(n);
-        a1.copy_from_slice(&st.a);
-        let p1 = self.take(n);
-        let q1 = self.take(n);
-        let v1 = self.take(n);
+        a1.copy_from_slice(a1_start);
+        let (p1, q1, v1) = (self.take(n), self.take(n), self.take(n));
         let mut f = std::mem::take(&mut self.f);
         f.resize(n, 0.0);
         let mut r = std::mem::replace(&mut self.residual, DVector::zeros(0));
@@ -577,7 +571,7 @@ impl GeneralizedAlpha {
                 f: &mut f,
                 r: &mut r,
             },
-            None,
+            resume,
         );
         self.f = f;
         self.residual = r;
@@ -610,8 +604,11 @@ impl GeneralizedAlpha {
         let mut power = [0.0; 3];
         let t1 = st.t + h;
         // A resumed iteration keeps its first iterate here.
-        let mut kept = std::mem::take(&mut self.kept);
-        kept.resize(n, 0.0);
+        let mut kept = Vec::new();
+        if resume.is_some() {
+            kept = std::mem::take(&mut self.kept);
+            kept.resize(n, 0.0);
+        }
         let Some(lu) = self.lu.as_ref() else {
             return Ok(None);
         };
@@ -704,7 +701,9 @@ impl GeneralizedAlpha {
                 if stands {
                     a1.copy_from_slice(&kept);
                 }
-                self.kept = kept;
+                if !kept.is_empty() {
+                    self.kept = kept;
+                }
                 if resumed {
                     self.moved = !stands;
                 }
