@@ -356,7 +356,8 @@ impl GeneralizedAlpha {
     }
 
     /// Check a provisional step end `st` with the accelerations `f_end` evaluated there (by a
-    /// caller that evaluates the state anyway), or with an evaluation of its own (`None`).
+    /// caller that evaluates the state anyway), or with an evaluation of its own (`None`, or a
+    /// slice whose length is not the number of coordinates).
     /// Newton's next increment is computed from it: if it is within the tolerance the state
     /// stands (`Ok(true)`); otherwise the iteration goes on from it as it would have, and `st`
     /// becomes its result (`Ok(false)`: what was evaluated at the old `st` is void). A step
